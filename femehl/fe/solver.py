@@ -1,0 +1,368 @@
+"""The finite-element soft-EHL solver: P1 pressure, P0 film, exact Boussinesq (design.md s. 4).
+
+Per step (paper section 3, lagged coefficients: ONE linear system):
+
+    beta K(d^k) p - (V Bx + M/dt) w = -V Bx h^{k+1} - M (h^{k+1} - d^k)/dt
+    w + C p = 0
+
+with C = c X P for the elastic half space (X the exact triangle influence at
+element centroids, mirrored for a half disk; P the element average of P1),
+C = P/k for a Winkler foundation and C = 0 for a rigid substrate.  With w
+eliminated the system in the free pressure unknowns is
+
+    A p = ( beta K(d^k) + V Bx C + M C / dt ) p = -V Bx h - M (h - d^k)/dt
+
+and only K changes from step to step: Bx C and M C depend on the mesh alone
+and are formed once.  ``d^{k+1} = h^{k+1} + C p^{k+1}`` on elements.
+
+Linear algebra (the step must still solve A p = b to a stated tolerance):
+a dense LU of a recent A is kept and used as the preconditioner of GMRES;
+the LU is refreshed when GMRES needs more than ``refactor_after``
+iterations, or when the step size changes.  ``rtol`` is the relative
+residual the step is solved to (default 1e-10).  ``linear_solver="lu"``
+refactorizes at every step instead (the paper's direct solve).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from skfem import Basis, ElementTriP0, ElementTriP1, asm
+
+from ..errors import SceneError, SingularSystemError
+from ..kernels import influence_matrix, triangle_influence
+from ..scene import HalfSpace, Rigid, Scene, Winkler
+from ..stepping import State
+from .forms import couette, film_diffusion, squeeze
+from .mesh import DiskMesh, load_mesh
+
+__all__ = ["FEStepper", "FEDisc", "COMPLIANCE", "compliance_operator"]
+
+
+class FEDisc:
+    """A disk mesh with the P1/P0 bases and interpolation of stored fields."""
+
+    def __init__(self, dm: DiskMesh):
+        self.dm = dm
+        self.mesh = dm.mesh
+        self.half = dm.half
+        self.L = dm.L
+        self.basis = Basis(self.mesh, ElementTriP1())
+        self.basis0 = self.basis.with_element(ElementTriP0())
+        p, t = self.mesh.p, self.mesh.t
+        self.nodes = p.T.copy()
+        self.tri = np.transpose(p[:, t], (2, 1, 0))            # (ne, 3, 2)
+        self.centroids = self.tri.mean(axis=1)
+        a = self.tri
+        self.areas = 0.5 * np.abs((a[:, 1, 0] - a[:, 0, 0]) * (a[:, 2, 1] - a[:, 0, 1])
+                                  - (a[:, 1, 1] - a[:, 0, 1]) * (a[:, 2, 0] - a[:, 0, 0]))
+        ne, nn = t.shape[1], p.shape[1]
+        # element average of a P1 field: (P p)_e = mean of its 3 nodal values
+        self.P = sp.csr_matrix((np.full(3 * ne, 1.0 / 3.0),
+                                (np.repeat(np.arange(ne), 3), t.T.ravel())), shape=(ne, nn))
+        r = np.hypot(p[0], p[1])
+        self.free = np.flatnonzero(r < self.L * (1.0 - 1e-9))
+        self._tri = None
+
+    @property
+    def nelements(self) -> int:
+        return self.mesh.t.shape[1]
+
+    @property
+    def nnodes(self) -> int:
+        return self.mesh.p.shape[1]
+
+    def _finder(self):
+        if self._tri is None:
+            import matplotlib.tri as mtri
+            self._tri = mtri.Triangulation(self.mesh.p[0], self.mesh.p[1], self.mesh.t.T)
+            self._finder_ = self._tri.get_trifinder()
+        return self._finder_
+
+    def _locate(self, points):
+        pts = np.asarray(points, dtype=float).copy()
+        if self.half:
+            pts[:, 1] = np.abs(pts[:, 1])
+        return pts, self._finder()(pts[:, 0], pts[:, 1])
+
+    def pressure_at(self, p, points):
+        """P1 interpolation; 0 outside the mesh (p = 0 beyond r = L)."""
+        import matplotlib.tri as mtri
+        pts, _ = self._locate(points)
+        self._finder()
+        f = mtri.LinearTriInterpolator(self._tri, np.asarray(p, dtype=float), trifinder=self._finder_)
+        v = f(pts[:, 0], pts[:, 1])
+        return np.ma.filled(v.astype(float), 0.0)
+
+    def _cell_value(self, values, points):
+        pts, e = self._locate(points)
+        out = np.full(pts.shape[0], np.nan)
+        ok = e >= 0
+        out[ok] = np.asarray(values)[e[ok]]
+        return out
+
+    def film_at(self, d, points):
+        """Element-constant film thickness (NaN outside the mesh)."""
+        return self._cell_value(d, points)
+
+    def deflection_at(self, w, points):
+        return self._cell_value(w, points)
+
+    def centreline(self, n: int = 401):
+        x = np.linspace(-self.L, self.L, n)
+        return np.column_stack([x, np.zeros_like(x)])
+
+
+# ---- elastic operators: w = -C p on elements ---------------------------------
+def _halfspace(substrate: HalfSpace, disc: FEDisc, free):
+    """Dense C[:, free] = c X P[:, free], X built in row blocks (no copy of X kept)."""
+    ne = disc.nelements
+    Pf = disc.P[:, free].tocsc()
+    C = np.empty((ne, free.size))
+    block = max(1, int(2**27 // (8 * ne)))          # ~128 MB of X rows at a time
+    for s in range(0, ne, block):
+        e = slice(s, min(s + block, ne))
+        Xb = influence_matrix(disc.centroids[e], disc.tri, mirror_y=disc.half)
+        C[e] = (Pf.T @ Xb.T).T
+    C *= substrate.compliance
+    return C
+
+
+def _winkler(substrate: Winkler, disc: FEDisc, free):
+    return (disc.P[:, free] / substrate.k).tocsr()
+
+
+def _rigid(substrate: Rigid, disc: FEDisc, free):
+    return sp.csr_matrix((disc.nelements, free.size))
+
+
+#: substrate type -> builder of C (elements x free nodes), w = -C p
+COMPLIANCE = {HalfSpace: _halfspace, Winkler: _winkler, Rigid: _rigid}
+
+
+def compliance_operator(substrate, disc, free):
+    try:
+        build = COMPLIANCE[type(substrate)]
+    except KeyError:
+        raise NotImplementedError(
+            f"the FE solver has no elastic operator for {type(substrate).__name__}; "
+            f"registered: {[c.__name__ for c in COMPLIANCE]}") from None
+    return build(substrate, disc, free)
+
+
+@dataclass
+class _Factor:
+    lu: tuple
+    dt: float
+    V: float
+
+
+class FEStepper:
+    """Advance the FE discretization of a scene by one lagged linear step.
+
+    Parameters
+    ----------
+    scene : femehl.scene.Scene
+    mesh : str, path, skfem.MeshTri or DiskMesh, default: "medium"
+        A ladder name ("coarse", "medium", "fine", "xfine") or any mesh meshio reads.
+    half : bool, optional
+        Use the half disk y >= 0; default: True when the indenter is symmetric in y.
+    linear_solver : {"gmres", "lu"}, default: "gmres"
+        "gmres": GMRES preconditioned by the LU of a recent step; "lu": a new
+        dense LU at every step.
+    rtol : float, default: 1e-10
+        Relative residual ||b - A p|| / ||b|| every step is solved to.
+    refactor_after : int, default: 8
+        Refresh the LU when GMRES needed more than this many iterations.
+    """
+
+    method = "fe"
+
+    def __init__(self, scene: Scene, mesh="medium", half: bool | None = None,
+                 linear_solver: str = "gmres", rtol: float = 1e-10, refactor_after: int = 8):
+        t0 = time.perf_counter()
+        self.scene = scene
+        symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
+        if half is None:
+            half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
+        if half and not symmetric:
+            raise SceneError("a half-disk mesh needs an indenter symmetric in y; use half=False "
+                             "or a full-disk mesh.")
+        dm = load_mesh(mesh, L=scene.domain.L, half=half)
+        if dm.half and not symmetric:
+            raise SceneError(f"mesh {dm.name!r} is a half disk but the indenter is not symmetric "
+                             "in y: use a full-disk mesh.")
+        if linear_solver not in ("gmres", "lu"):
+            raise SceneError(f"linear_solver must be 'gmres' or 'lu', got {linear_solver!r}.")
+        if not (0.0 < float(rtol) < 1e-2):
+            raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
+        self.linear_solver = linear_solver
+        self.rtol = float(rtol)
+        self.refactor_after = int(refactor_after)
+        self.disc = disc = FEDisc(dm)
+        free = disc.free
+        self.free = free
+        self.beta = scene.fluid.beta
+        self.shape = np.asarray(scene.indenter.gap(disc.centroids[:, 0], disc.centroids[:, 1]), float)
+        b1, b0 = disc.basis, disc.basis0
+        # element stiffness with unit coefficient; K(d) scales each element by d^3
+        kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(disc.nelements)))
+        self._k_rows, self._k_cols = kcoo.indices
+        self._k_data = kcoo.data.reshape(-1, disc.nelements)       # (9, ne), element last
+        self.Bx = asm(couette, b0, b1).tocsr()[free]                 # (nfree, ne)
+        self.M = asm(squeeze, b0, b1).tocsr()[free]
+        self.node_weight = np.asarray(asm(squeeze, b0, b1).sum(axis=1)).ravel()  # int phi_q dA
+        self.mult = 2.0 if disc.half else 1.0
+        t1 = time.perf_counter()
+        self.C = compliance_operator(scene.substrate, disc, free)
+        self.dense = isinstance(self.C, np.ndarray)
+        t2 = time.perf_counter()
+        if self.dense:
+            self.BxC = np.asarray(self.Bx @ self.C)
+            self.MC = np.asarray(self.M @ self.C)
+        else:
+            self.BxC = sp.csr_matrix(self.Bx @ self.C)
+            self.MC = sp.csr_matrix(self.M @ self.C)
+        # exact deflection at the centre: one kernel row, for film_center
+        self._centre_row = self._centre_operator()
+        self._factor: _Factor | None = None
+        self.info = {
+            "method": "fe", "mesh": dm.name, "half": dm.half, "elements": disc.nelements,
+            "nodes": disc.nnodes, "unknowns": int(free.size),
+            "substrate": type(scene.substrate).__name__,
+            "setup_s": time.perf_counter() - t0, "elastic_build_s": t2 - t1,
+            "operator_bytes": int(_nbytes(self.C) + _nbytes(self.BxC) + _nbytes(self.MC)),
+            "factorizations": 0, "krylov_iterations": 0,
+        }
+
+    def _centre_operator(self):
+        """Row r with w(0, 0) = -r . p_free (exact kernel for the element-average pressure)."""
+        if self.dense:
+            x0 = triangle_influence(np.zeros((1, 2)), self.disc.tri)[0]
+            x0 = x0 * (2.0 if self.disc.half else 1.0)       # mirror image at y = 0 is symmetric
+            return self.scene.substrate.compliance * (self.disc.P[:, self.free].T @ x0)
+        return None
+
+    # ---- operators ----------------------------------------------------------
+    def stiffness(self, d: np.ndarray):
+        """K(d^k) on the free nodes, element coefficient (d^k)^3."""
+        data = (self._k_data * (d ** 3)[None, :]).ravel()
+        n = self.disc.nnodes
+        K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
+        return K[self.free][:, self.free]
+
+    def _matrix(self, K, V, dt):
+        if self.dense:
+            A = self.beta * K.toarray()
+            A += V * self.BxC
+            A += self.MC / dt
+            return A
+        return (self.beta * K + V * self.BxC + self.MC / dt).tocsc()
+
+    def _solve(self, K, V, dt, rhs, t_new):
+        bnorm = float(np.linalg.norm(rhs))
+        if bnorm == 0.0:
+            return np.zeros_like(rhs), 0
+        if not self.dense:
+            A = self._matrix(K, V, dt)
+            return spla.spsolve(A, rhs), 0
+        if self.linear_solver == "lu":
+            return self._direct(K, V, dt, rhs, t_new), 0
+        f = self._factor
+        if f is None or abs(f.dt - dt) > 1e-9 * dt:
+            return self._direct(K, V, dt, rhs, t_new), 0
+
+        def matvec(x):
+            return self.beta * (K @ x) + self.BxC @ (V * x) + self.MC @ (x / dt)
+
+        n = rhs.size
+        A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        Minv = spla.LinearOperator((n, n), matvec=lambda x: sla.lu_solve(f.lu, x), dtype=float)
+        x0 = sla.lu_solve(f.lu, rhs)
+        its = [0]
+
+        def count(_):
+            its[0] += 1
+
+        x, flag = spla.gmres(A, rhs, x0=x0, rtol=self.rtol, atol=0.0, M=Minv, restart=30,
+                             maxiter=3, callback=count, callback_type="pr_norm")
+        res = np.linalg.norm(rhs - matvec(x)) / bnorm
+        self.info["krylov_iterations"] += its[0]
+        if flag != 0 or not np.isfinite(res) or res > 10 * self.rtol:
+            return self._direct(K, V, dt, rhs, t_new), its[0]
+        if its[0] > self.refactor_after:
+            self._factor = None          # refresh at the next step
+        return x, its[0]
+
+    def _direct(self, K, V, dt, rhs, t_new):
+        A = self._matrix(K, V, dt)
+        try:
+            lu = sla.lu_factor(A, overwrite_a=True, check_finite=True)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise SingularSystemError(f"FE step at t = {t_new:.6g}: cannot factor the system "
+                                      f"({exc}). Try a smaller dt or a finer mesh.", t=t_new) from None
+        if np.any(np.abs(np.diag(lu[0])) == 0.0):
+            raise SingularSystemError(
+                f"FE step at t = {t_new:.6g}: the linear system is singular (zero pivot). "
+                "Check the scene (a rigid substrate needs a squeeze or sliding term) or try a "
+                "smaller dt.", t=t_new)
+        self._factor = _Factor(lu, dt, V)
+        self.info["factorizations"] += 1
+        return sla.lu_solve(lu, rhs)
+
+    # ---- stepping -----------------------------------------------------------
+    def _state(self, step, t, hc, V, p_free, info=None):
+        disc = self.disc
+        p = np.zeros(disc.nnodes)
+        p[self.free] = p_free
+        Cp = np.asarray(self.C @ p_free).ravel()
+        w = -Cp
+        d = hc + self.shape + Cp
+        load = self.mult * float(self.node_weight @ p)
+        if self._centre_row is not None:
+            w0 = -float(self._centre_row @ p_free)
+        else:
+            w0 = float(disc.deflection_at(w, np.zeros((1, 2)))[0])
+        s0 = float(self.scene.indenter.gap(0.0, 0.0))
+        i_min = int(np.argmin(d))
+        i_max = int(np.argmax(p))
+        return State(step=step, t=t, hc=hc, V=V, p=p, w=w, d=d, load=load,
+                     film_center=hc + s0 - w0, film_min=float(d[i_min]),
+                     film_min_at=tuple(disc.centroids[i_min]), p_max=float(p[i_max]),
+                     p_max_at=tuple(disc.nodes[i_max]), info=info or {})
+
+    def initial_state(self) -> State:
+        mo = self.scene.motion
+        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.free.size))
+
+    def step(self, state: State, t_new: float, dt: float) -> State:
+        mo = self.scene.motion
+        hc, V = mo.hc(t_new), mo.V(t_new)
+        h = hc + self.shape
+        K = self.stiffness(state.d)
+        rhs = -V * (self.Bx @ h) - self.M @ (h - state.d) / dt
+        p, its = self._solve(K, V, dt, rhs, t_new)
+        if not np.all(np.isfinite(p)):
+            raise SingularSystemError(
+                f"FE step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
+                "or ill-conditioned. Try a smaller dt or a finer mesh.", t=t_new)
+        return self._state(state.step + 1, t_new, hc, V, p, info={"krylov_iterations": its})
+
+
+def _nbytes(a) -> int:
+    if isinstance(a, np.ndarray):
+        return a.nbytes
+    if sp.issparse(a):
+        a = a.tocsr()
+        return a.data.nbytes + a.indices.nbytes + a.indptr.nbytes
+    return 0
+
+
+def _looks_like_path(s: str) -> bool:
+    return any(ch in s for ch in "/\\.")

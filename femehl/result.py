@@ -1,0 +1,140 @@
+"""The outcome of a run: per-step scalars and stored fields, with interpolation.
+
+A :class:`Result` is filled by consuming the states of
+:func:`femehl.stepping.march`; it never steps anything itself.  Fields are
+interpolated by the discretization that produced them (FD: bilinear in
+(theta, r); FE: P1 pressure, element-constant film), and linearly in time
+between the two stored states around the requested time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import SceneError
+from .stepping import State
+
+__all__ = ["Result"]
+
+_SCALARS = ("t", "hc", "V", "load", "film_center", "film_min", "p_max")
+
+
+@dataclass
+class Result:
+    """Arrays with one entry per step (``t``, ``load``, ``film_center``, ...).
+
+    Attributes
+    ----------
+    scene : femehl.scene.Scene
+    method : str
+        Name of the solver that produced it ("fd" or "fe").
+    disc : object
+        The discretization (grid or mesh), able to interpolate its fields.
+    """
+
+    scene: object
+    method: str
+    disc: object
+    _rows: dict = field(default_factory=lambda: {k: [] for k in _SCALARS + ("film_min_at", "p_max_at")})
+    _stored: list = field(default_factory=list)
+    info: dict = field(default_factory=dict)
+
+    def record(self, state: State, store_fields: bool = True) -> None:
+        """Append one state's scalars (and its fields when ``store_fields``)."""
+        for k in _SCALARS:
+            self._rows[k].append(float(getattr(state, k)))
+        self._rows["film_min_at"].append(tuple(state.film_min_at))
+        self._rows["p_max_at"].append(tuple(state.p_max_at))
+        if store_fields:
+            self._stored.append(state)
+
+    # ---- per-step arrays ----------------------------------------------------
+    def __getattr__(self, name):
+        rows = self.__dict__.get("_rows", {})
+        if name in rows:
+            return np.asarray(rows[name], dtype=float)
+        raise AttributeError(name)
+
+    @property
+    def nsteps(self) -> int:
+        return len(self._rows["t"]) - 1
+
+    @property
+    def stored_times(self) -> np.ndarray:
+        return np.array([s.t for s in self._stored])
+
+    @property
+    def states(self) -> list:
+        """The stored states, in time order."""
+        return list(self._stored)
+
+    def state_at(self, t: float) -> State:
+        """The stored state whose time is closest to ``t``."""
+        ts = self.stored_times
+        if ts.size == 0:
+            raise SceneError("this result stored no fields: run with store_every >= 1.")
+        return self._stored[int(np.argmin(np.abs(ts - t)))]
+
+    # ---- interpolation ------------------------------------------------------
+    def _bracket(self, t):
+        ts = self.stored_times
+        if ts.size == 0:
+            raise SceneError("this result stored no fields: run with store_every >= 1.")
+        t = float(t)
+        tol = 1e-9 * max(1.0, abs(ts[-1]))
+        if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
+            raise SceneError(f"t = {t} is outside the stored times [{ts[0]:g}, {ts[-1]:g}].")
+        j = int(np.searchsorted(ts, t))
+        if j < ts.size and abs(ts[j] - t) <= tol:
+            return [(self._stored[j], 1.0)]
+        if j > 0 and abs(ts[j - 1] - t) <= tol:
+            return [(self._stored[j - 1], 1.0)]
+        a = (t - ts[j - 1]) / (ts[j] - ts[j - 1])
+        return [(self._stored[j - 1], 1.0 - a), (self._stored[j], a)]
+
+    @staticmethod
+    def _points(points):
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim == 1 and pts.size == 2:
+            pts = pts[None, :]
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise SceneError(f"points must have shape (n, 2), got {pts.shape}.")
+        if not np.all(np.isfinite(pts)):
+            raise SceneError("points must be finite.")
+        return pts
+
+    def pressure_at(self, points, t: float) -> np.ndarray:
+        """Pressure at ``points`` (n, 2) and time ``t`` (normalized); 0 outside the domain."""
+        pts = self._points(points)
+        return sum(wt * self.disc.pressure_at(s.p, pts) for s, wt in self._bracket(t))
+
+    def film_at(self, points, t: float) -> np.ndarray:
+        """Film thickness d = h - w at ``points`` (n, 2) and time ``t``."""
+        pts = self._points(points)
+        return sum(wt * self.disc.film_at(s.d, pts) for s, wt in self._bracket(t))
+
+    def deflection_at(self, points, t: float) -> np.ndarray:
+        """Surface deflection w (negative under pressure) at ``points`` and time ``t``."""
+        pts = self._points(points)
+        return sum(wt * self.disc.deflection_at(s.w, pts) for s, wt in self._bracket(t))
+
+    # ---- tables -------------------------------------------------------------
+    def summary(self) -> dict:
+        """Per-step columns as a dict of arrays (the summary CSV's content)."""
+        out = {k: getattr(self, k) for k in _SCALARS}
+        at = np.asarray(self._rows["film_min_at"], dtype=float).reshape(-1, 2)
+        pa = np.asarray(self._rows["p_max_at"], dtype=float).reshape(-1, 2)
+        out.update(film_min_x=at[:, 0], film_min_y=at[:, 1], p_max_x=pa[:, 0], p_max_y=pa[:, 1])
+        return out
+
+    def value_at(self, name: str, t: float) -> float:
+        """A per-step scalar (e.g. "load") at time ``t``, linear in time between steps."""
+        return float(np.interp(t, self.t, getattr(self, name)))
+
+    def save(self, folder) -> "pathlib.Path":  # noqa: F821
+        """Write the summary CSV, centreline PNG and field series to ``folder``."""
+        from .output import write_all
+
+        return write_all(self, folder)

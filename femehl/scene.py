@@ -1,0 +1,467 @@
+"""Frozen descriptions of a soft-EHL problem: indenter, substrate, fluid, motion, domain.
+
+Conventions (design.md sections 1-2; Wu, Hui et al., JMPS 2022, Eqs. 8, 10, 12)
+------------------------------------------------------------------------------
+Everything in a :class:`Scene` is in the paper's normalized variables::
+
+    r = r*/sqrt(R h_inf)     t = V_ss t*/(2 sqrt(R h_inf))
+    h, w, d = (.)*/h_inf     p = p*/(4 pi G sqrt(h_inf/R))
+    beta = (2/3) (h_inf^2/R) (pi G)/(eta V_ss)
+
+so the problem solved is::
+
+    beta div(d^3 grad p) = -V(t) dd/dx + dd/dt          (Eq. 10a in Cartesian form)
+    d = h - w,   h = hc(t) + s(x, y),   w = -c * int p/|x - x'| dA'     (Eq. 10b)
+
+with ``c = 2 (1 - nu)`` (1 for the incompressible half space of the paper).
+Signs: w < 0 under positive pressure; hc > 0 is a gap, hc < 0 an indentation;
+the indenter slides toward +x, so in its frame the substrate moves toward -x,
+the inlet is at +x and the exit constriction near x = -1.  (The paper's
+Eq. 2c writes h = hc - r^2/2R, a sign slip; femehl uses + as in Eq. 12.)
+
+:class:`Dimensional` converts SI inputs to a scene and back.
+Scenes are immutable; validation happens at construction and raises
+:class:`femehl.errors.SceneError` with a message that names the fix.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Protocol, runtime_checkable
+
+import numpy as np
+
+from .errors import SceneError
+
+__all__ = [
+    "Sphere", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
+    "Scene", "Dimensional", "TimeFunction", "Constant", "Table", "RampHold",
+    "TanhStart", "check_positive", "check_finite",
+]
+
+
+# --------------------------------------------------------------------------
+# validation helpers
+# --------------------------------------------------------------------------
+def check_finite(name: str, value, hint: str = "") -> float:
+    """Return ``value`` as a float, or raise SceneError if it is not a finite number."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a number, got {value!r}. {hint}".strip()) from None
+    if not math.isfinite(v):
+        raise SceneError(f"{name} must be finite, got {v}. {hint}".strip())
+    return v
+
+
+def check_positive(name: str, value, hint: str = "") -> float:
+    """Return ``value`` as a float, or raise SceneError if it is not finite and > 0."""
+    v = check_finite(name, value, hint)
+    if v <= 0.0:
+        raise SceneError(f"{name} must be > 0, got {v}. {hint}".strip())
+    return v
+
+
+# --------------------------------------------------------------------------
+# time functions (gap history hc(t), sliding velocity V(t), imposed load F(t))
+# --------------------------------------------------------------------------
+@runtime_checkable
+class TimeFunction(Protocol):
+    """A scalar function of normalized time; ``f(t)`` returns a float."""
+
+    def __call__(self, t: float) -> float: ...
+
+
+@dataclass(frozen=True)
+class Constant:
+    """``f(t) = value`` for all t."""
+
+    value: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "value", check_finite("Constant value", self.value))
+
+    def __call__(self, t: float) -> float:
+        return self.value
+
+
+@dataclass(frozen=True)
+class Table:
+    """Piecewise-linear function through ``(times[i], values[i])``, constant outside.
+
+    Parameters
+    ----------
+    times : sequence of float
+        Strictly increasing sample times (at least one).
+    values : sequence of float
+        Values at those times, same length, finite.
+    """
+
+    times: tuple
+    values: tuple
+
+    def __post_init__(self):
+        try:
+            t = np.asarray(self.times, dtype=float).ravel()
+            v = np.asarray(self.values, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise SceneError("Table times and values must be sequences of numbers.") from None
+        if t.size == 0:
+            raise SceneError("Table is empty: give at least one (time, value) pair.")
+        if t.size != v.size:
+            raise SceneError(
+                f"Table has {t.size} times but {v.size} values: give one value per time.")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+            raise SceneError("Table times and values must be finite (no NaN or inf).")
+        if np.any(np.diff(t) <= 0):
+            raise SceneError(
+                "Table times must be strictly increasing: sort the rows and remove duplicates.")
+        object.__setattr__(self, "times", tuple(t.tolist()))
+        object.__setattr__(self, "values", tuple(v.tolist()))
+
+    def __call__(self, t: float) -> float:
+        return float(np.interp(t, self.times, self.values))
+
+
+@dataclass(frozen=True)
+class RampHold:
+    """The paper's gap history (Eq. 12a): a linear ramp from ``h0`` to ``h_end`` then hold.
+
+    ``hc(t) = h0 + (h_end - h0) t / t1`` for ``t <= t1``, ``hc = h_end`` after.
+    """
+
+    h0: float = 0.1
+    h_end: float = -1.0
+    t1: float = 1.0
+
+    def __post_init__(self):
+        check_finite("h0", self.h0)
+        check_finite("h_end", self.h_end)
+        check_positive("t1 (end of the ramp)", self.t1)
+
+    def __call__(self, t: float) -> float:
+        s = min(max(t / self.t1, 0.0), 1.0)
+        return self.h0 + (self.h_end - self.h0) * s
+
+
+@dataclass(frozen=True)
+class TanhStart:
+    """The paper's sliding start (Eq. 5, 12c): ``V = V_ss tanh((t - t1)/T)`` for t >= t1, else 0."""
+
+    t1: float = 1.0
+    T: float = 1.0
+    V_ss: float = 1.0
+
+    def __post_init__(self):
+        check_finite("t1 (start of sliding)", self.t1)
+        check_positive("T (sliding ramp time)", self.T)
+        check_finite("V_ss", self.V_ss)
+
+    def __call__(self, t: float) -> float:
+        return 0.0 if t < self.t1 else self.V_ss * math.tanh((t - self.t1) / self.T)
+
+
+def _as_time_function(name: str, f) -> Callable[[float], float]:
+    if isinstance(f, (int, float)) and not isinstance(f, bool):
+        return Constant(f)
+    if not callable(f):
+        raise SceneError(f"{name} must be a number or a callable of time, got {type(f).__name__}.")
+    return f
+
+
+# --------------------------------------------------------------------------
+# indenters
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Sphere:
+    """A rigid sphere (paraboloid near its tip): ``s(x, y) = (x^2 + y^2) / (2 R)``.
+
+    Parameters
+    ----------
+    R : float, default: 1.0
+        Radius in units of the normalization length ``sqrt(R* h_inf)/sqrt(R*/h_inf)``;
+        the paper's normalization makes it 1.
+    """
+
+    R: float = 1.0
+    symmetric_y = True
+    axisymmetric = True
+
+    def __post_init__(self):
+        check_positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization.")
+
+    def gap(self, x, y):
+        """Rigid gap shape s(x, y) (>= 0, zero at the tip), broadcast over arrays."""
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        return (x * x + y * y) / (2.0 * self.R)
+
+
+# --------------------------------------------------------------------------
+# substrates
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class HalfSpace:
+    """Elastic half space (Boussinesq, Eq. 3 / 10b).  ``compliance = 2 (1 - nu)``."""
+
+    nu: float = 0.5
+    kind = "halfspace"
+
+    def __post_init__(self):
+        nu = check_finite("Poisson ratio nu", self.nu)
+        if not (-1.0 < nu <= 0.5):
+            raise SceneError(f"Poisson ratio nu must lie in (-1, 0.5], got {nu}.")
+
+    @property
+    def compliance(self) -> float:
+        """Factor multiplying the normalized Boussinesq integral (1 for nu = 0.5)."""
+        return 2.0 * (1.0 - self.nu)
+
+
+@dataclass(frozen=True)
+class Rigid:
+    """Rigid substrate: w = 0, no elastic operator at all."""
+
+    kind = "rigid"
+
+
+@dataclass(frozen=True)
+class Winkler:
+    """Winkler foundation: ``w = -p / k`` (local, diagonal)."""
+
+    k: float = 1.0
+    kind = "winkler"
+
+    def __post_init__(self):
+        check_positive("Winkler stiffness k", self.k)
+
+
+# --------------------------------------------------------------------------
+# fluid, motion, domain, scene
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Fluid:
+    """The film's Newtonian fluid, through the paper's ``beta`` (Eq. 10e)."""
+
+    beta: float = 200.0
+
+    def __post_init__(self):
+        check_positive("beta", self.beta,
+                       "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it.")
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Tip clearance ``hc(t)`` and sliding velocity ``V(t)`` (indenter moves toward +x).
+
+    Parameters
+    ----------
+    gap : callable or float, default: RampHold()
+        Tip clearance hc(t); hc > 0 is a gap, hc < 0 an indentation.
+    velocity : callable or float, default: 0.0
+        Sliding velocity V(t) in units of V_ss.
+    """
+
+    gap: Callable[[float], float] = field(default_factory=RampHold)
+    velocity: Callable[[float], float] = field(default_factory=Constant)
+
+    def __post_init__(self):
+        object.__setattr__(self, "gap", _as_time_function("Motion gap hc(t)", self.gap))
+        object.__setattr__(self, "velocity", _as_time_function("Motion velocity V(t)", self.velocity))
+
+    def hc(self, t: float) -> float:
+        return check_finite(f"hc(t={t:g})", self.gap(t), "The gap history must return finite values.")
+
+    def V(self, t: float) -> float:
+        return check_finite(f"V(t={t:g})", self.velocity(t),
+                            "The velocity history must return finite values.")
+
+
+@dataclass(frozen=True)
+class Domain:
+    """Computational disk ``r <= L`` (pressure vanishes on r = L)."""
+
+    L: float = 2.0
+
+    def __post_init__(self):
+        check_positive("Domain radius L", self.L)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything a solver needs to know about the physics, in normalized units."""
+
+    indenter: Sphere = field(default_factory=Sphere)
+    substrate: HalfSpace | Rigid | Winkler = field(default_factory=HalfSpace)
+    fluid: Fluid = field(default_factory=Fluid)
+    motion: Motion = field(default_factory=Motion)
+    domain: Domain = field(default_factory=Domain)
+
+    def __post_init__(self):
+        for name, cls in (("fluid", Fluid), ("motion", Motion), ("domain", Domain)):
+            if not isinstance(getattr(self, name), cls):
+                raise SceneError(f"Scene.{name} must be a {cls.__name__}, got "
+                                 f"{type(getattr(self, name)).__name__}.")
+        if not hasattr(self.indenter, "gap"):
+            raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
+        hc0 = self.motion.hc(0.0)
+        if hc0 <= 0.0:
+            raise SceneError(
+                f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
+                "film thickness d = hc + s would be <= 0 at the tip. Start with a positive gap "
+                "(the paper case uses h0 = +0.1).")
+        self._check_domain_holds_contact()
+
+    def _check_domain_holds_contact(self):
+        """The domain must reach well past the largest contact radius of the run."""
+        L = self.domain.L
+        # deepest indentation over a generous horizon, for a sphere a ~ sqrt(2 R |hc|)
+        R = getattr(self.indenter, "R", None)
+        if R is None:
+            return
+        gap = self.motion.gap
+        if isinstance(gap, RampHold):
+            hmin = min(gap.h0, gap.h_end)
+        elif isinstance(gap, Table):
+            hmin = min(gap.values)
+        elif isinstance(gap, Constant):
+            hmin = gap.value
+        else:
+            return
+        if hmin < 0.0:
+            a = math.sqrt(R * (-hmin))  # Hertz contact radius for indentation depth |hc|
+            if L < 1.5 * a:
+                raise SceneError(
+                    f"Domain radius L = {L:g} is too small to hold the contact: an indentation "
+                    f"hc = {hmin:g} makes a contact of radius about {a:.3g}, and the pressure "
+                    f"must decay before r = L. Use L >= {1.5 * a:.3g} (the paper uses L = 2a).")
+
+    # ---- what the scene calls for (design.md section 6) -------------------
+    def has_sliding(self, t_end: float, n: int = 2001) -> bool:
+        ts = np.linspace(0.0, t_end, n)
+        return any(self.motion.V(t) != 0.0 for t in ts)
+
+    def has_squeeze(self, t_end: float, n: int = 2001) -> bool:
+        ts = np.linspace(0.0, t_end, n)
+        h = [self.motion.hc(t) for t in ts]
+        return max(h) != min(h)
+
+    def effects(self, t_end: float) -> dict:
+        """The terms the solver must assemble for a run to ``t_end``."""
+        return {
+            "squeeze": self.has_squeeze(t_end),
+            "sliding": self.has_sliding(t_end),
+            "elasticity": self.substrate.kind,
+        }
+
+
+# --------------------------------------------------------------------------
+# SI <-> normalized
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Dimensional:
+    """A real experiment in SI units and the paper's scales (Eq. 8, 10e).
+
+    Parameters
+    ----------
+    R : float
+        Sphere radius [m].
+    G : float
+        Shear modulus of the substrate [Pa].
+    eta : float
+        Fluid viscosity [Pa s].
+    V_ss : float
+        Steady sliding speed [m/s] (also sets the time scale).
+    h_inf : float
+        Final indentation depth [m] (length scale of film and deflection).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate.
+    """
+
+    R: float
+    G: float
+    eta: float
+    V_ss: float
+    h_inf: float
+    nu: float = 0.5
+
+    def __post_init__(self):
+        for name in ("R", "G", "eta", "V_ss", "h_inf"):
+            check_positive(f"{name} [SI]", getattr(self, name))
+        HalfSpace(self.nu)
+
+    @property
+    def beta(self) -> float:
+        """beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss)   (Eq. 10e)."""
+        return (2.0 / 3.0) * (self.h_inf ** 2 / self.R) * math.pi * self.G / (self.eta * self.V_ss)
+
+    @property
+    def length(self) -> float:
+        """In-plane scale sqrt(R h_inf) [m] (the Hertz contact radius)."""
+        return math.sqrt(self.R * self.h_inf)
+
+    @property
+    def height(self) -> float:
+        """Film / deflection scale h_inf [m]."""
+        return self.h_inf
+
+    @property
+    def time(self) -> float:
+        """Time scale 2 sqrt(R h_inf)/V_ss [s]."""
+        return 2.0 * self.length / self.V_ss
+
+    @property
+    def pressure(self) -> float:
+        """Pressure scale 4 pi G sqrt(h_inf/R) [Pa]."""
+        return 4.0 * math.pi * self.G * math.sqrt(self.h_inf / self.R)
+
+    @property
+    def force(self) -> float:
+        """Load scale = pressure * length^2 [N]."""
+        return self.pressure * self.length ** 2
+
+    @property
+    def velocity(self) -> float:
+        return self.V_ss
+
+    def to_si(self, quantity: str, value):
+        """Multiply a normalized ``value`` by the scale of ``quantity``.
+
+        ``quantity`` is one of length, height, time, pressure, force, velocity.
+        """
+        scales = {q: getattr(self, q) for q in
+                  ("length", "height", "time", "pressure", "force", "velocity")}
+        if quantity not in scales:
+            raise SceneError(f"unknown quantity {quantity!r}; choose one of {sorted(scales)}.")
+        return np.asarray(value) * scales[quantity]
+
+    def from_si(self, quantity: str, value):
+        """Inverse of :meth:`to_si`."""
+        return np.asarray(value) / self.to_si(quantity, 1.0)
+
+    def scene(self, h0: float, t1: float | None = None, T: float | None = None,
+              L: float = 2.0) -> Scene:
+        """The paper's ramp-hold-slide experiment for these SI values.
+
+        Parameters
+        ----------
+        h0 : float
+            Initial clearance [m] (> 0).
+        t1 : float, default: one time scale
+            End of the indentation ramp and start of sliding [s].
+        T : float, default: t1
+            Sliding ramp time [s].
+        L : float, default: 2.0
+            Normalized domain radius.
+        """
+        h0 = check_positive("h0 [m] (initial clearance)", h0)
+        t1n = 1.0 if t1 is None else check_positive("t1 [s]", t1) / self.time
+        Tn = t1n if T is None else check_positive("T [s]", T) / self.time
+        return Scene(
+            indenter=Sphere(1.0),
+            substrate=HalfSpace(self.nu),
+            fluid=Fluid(self.beta),
+            motion=Motion(gap=RampHold(h0 / self.h_inf, -1.0, t1n), velocity=TanhStart(t1n, Tn)),
+            domain=Domain(L),
+        )

@@ -1,0 +1,99 @@
+"""The time loop as a generator of :class:`State`, shared by every solver.
+
+A *stepper* (one per discretization: ``femehl.fd.FDStepper``,
+``femehl.fe.FEStepper``) knows how to build its operators once and how to
+advance one step; this module only walks time.  The scheme is the paper's
+(section 3): every nonlinear coefficient is lagged one step, so each step is
+ONE linear solve.  ``march`` yields the initial state and then one state per
+step, so a caller can stop, store or plot whenever it likes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Iterator, Protocol
+
+import numpy as np
+
+from .errors import FilmRuptureError, SceneError
+
+__all__ = ["State", "Stepper", "march", "check_run"]
+
+
+@dataclass(frozen=True)
+class State:
+    """Everything known at one time level.
+
+    ``p`` lives on the solver's pressure unknowns (FD: grid nodes; FE: mesh
+    nodes), ``w`` and ``d`` on its film locations (FD: grid nodes; FE: element
+    centroids).  Scalars are whole-plane figures in normalized units.
+    """
+
+    step: int
+    t: float
+    hc: float
+    V: float
+    p: np.ndarray
+    w: np.ndarray
+    d: np.ndarray
+    load: float
+    film_center: float
+    film_min: float
+    film_min_at: tuple
+    p_max: float
+    p_max_at: tuple
+    info: dict = field(default_factory=dict)
+
+
+class Stepper(Protocol):
+    """What :func:`march` needs from a discretization."""
+
+    def initial_state(self) -> State: ...
+
+    def step(self, state: State, t_new: float, dt: float) -> State: ...
+
+
+def check_run(t_end, dt):
+    """Validate a run's horizon and step; return them as floats and the step count."""
+    from .scene import check_positive
+
+    t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
+    dt = check_positive("dt", dt, "Give a positive time step (the paper uses 0.01).")
+    if dt > t_end:
+        raise SceneError(f"dt = {dt:g} is larger than t_end = {t_end:g}: use dt <= t_end.")
+    n = int(math.ceil(t_end / dt - 1e-9))
+    if n > 10_000_000:
+        raise SceneError(f"{n} steps is too many: increase dt or decrease t_end.")
+    return t_end, dt, n
+
+
+def march(stepper: Stepper, t_end: float, dt: float) -> Iterator[State]:
+    """Yield the initial state, then one :class:`State` per step up to ``t_end``.
+
+    The last step is shortened so the run ends exactly at ``t_end``.  A film
+    thickness reaching zero raises :class:`~femehl.errors.FilmRuptureError`
+    from the step that produced it (everything yielded before stays valid).
+    """
+    t_end, dt, n = check_run(t_end, dt)
+    state = stepper.initial_state()
+    yield state
+    for k in range(1, n + 1):
+        t_new = min(k * dt, t_end)
+        h = t_new - state.t
+        if h <= 1e-14:
+            break
+        state = stepper.step(state, t_new, h)
+        _check_film(state)
+        yield state
+
+
+def _check_film(state: State):
+    if not (math.isfinite(state.film_min) and state.film_min > 0.0):
+        x, y = state.film_min_at
+        raise FilmRuptureError(
+            f"film thickness reached {state.film_min:.3g} <= 0 at t = {state.t:.6g}, "
+            f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
+            "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
+            "load truly squeezes the film out, the lubricated model no longer applies.",
+            t=state.t, where=(x, y), d_min=state.film_min)

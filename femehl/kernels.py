@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["triangle_influence", "influence_matrix", "quad_influence"]
+__all__ = ["triangle_influence", "influence_matrix", "quad_influence", "mesh_edges", "edge_terms"]
 
 _BLOCK_BYTES = 64 * 2**20  # temporaries per block of rows
 
@@ -157,4 +157,82 @@ def quad_influence(points, quad):
     w = np.ones(q.shape[0])
     _fill(out, pts, t1, w)
     _fill(out, pts, t2, w, accumulate=True)
+    return out
+
+
+# --------------------------------------------------------------------------
+# fast path for meshes: one term per unique edge, shared by its two triangles
+# --------------------------------------------------------------------------
+def mesh_edges(t, nodes):
+    """Unique edges of a triangulation and their signed incidence.
+
+    Parameters
+    ----------
+    t : array_like of int, shape (3, ne)
+        Triangle node indices (any orientation).
+    nodes : array_like, shape (nn, 2)
+
+    Returns
+    -------
+    edges : numpy.ndarray of int, shape (nedges, 2)
+        Node pairs (B, C), each edge once.
+    S : scipy.sparse.csr_matrix, shape (nedges, ne)
+        ``I(A, T_j) = sum_k S[k, j] * edge_term(A, edge_k)``: the triangle's
+        orientation sign times +1 where the triangle's cycle runs B -> C.
+    """
+    import scipy.sparse as sp
+
+    t = np.asarray(t)
+    nodes = np.asarray(nodes, dtype=float)
+    ne = t.shape[1]
+    tri = np.transpose(nodes[t], (1, 0, 2))
+    sgn = _orientation(tri)
+    a = np.concatenate([t[0], t[1], t[2]])
+    b = np.concatenate([t[1], t[2], t[0]])
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    key = lo.astype(np.int64) * (nodes.shape[0] + 1) + hi
+    uniq, inv = np.unique(key, return_inverse=True)
+    edges = np.column_stack([uniq // (nodes.shape[0] + 1), uniq % (nodes.shape[0] + 1)]).astype(np.int64)
+    direction = np.where(a == edges[inv, 0], 1.0, -1.0)
+    cols = np.tile(np.arange(ne), 3)
+    S = sp.csr_matrix((direction * np.tile(sgn, 3), (inv, cols)), shape=(edges.shape[0], ne))
+    return edges, S
+
+
+def edge_terms(points, nodes, edges, out=None):
+    """``T[i, k] = h (asinh(sC/|h|) - asinh(sB/|h|))`` for A = points[i], edge k = (B, C).
+
+    The same quantity as the per-edge term of :func:`triangle_influence`,
+    written with the vertex distances rho = |B - A|, |C - A| as
+    ``h * log((sC + rhoC)/(sB + rhoB))`` (or its mirror form when the foot of
+    A lies beyond C, to avoid cancellation), so each term costs one log.
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    nodes = np.asarray(nodes, dtype=float)
+    edges = np.asarray(edges)
+    B, C = edges[:, 0], edges[:, 1]
+    e = nodes[C] - nodes[B]
+    le = np.hypot(e[:, 0], e[:, 1])
+    ex, ey = e[:, 0] / le, e[:, 1] / le
+    nE = edges.shape[0]
+    if out is None:
+        out = np.empty((pts.shape[0], nE))
+    rows = max(1, _BLOCK_BYTES // (8 * 6 * max(nE, nodes.shape[0])))
+    for s in range(0, pts.shape[0], rows):
+        sl = slice(s, min(s + rows, pts.shape[0]))
+        dx = nodes[None, :, 0] - pts[sl, 0:1]          # (rows, nn): vertex - A
+        dy = nodes[None, :, 1] - pts[sl, 1:2]
+        rho = np.hypot(dx, dy)
+        bx, by = dx[:, B], dy[:, B]
+        h = bx * ey - by * ex
+        sb = bx * ex + by * ey
+        sc = sb + le
+        rb, rc = rho[:, B], rho[:, C]
+        flip = (sb + sc) < 0.0
+        num = np.where(flip, rb - sb, sc + rc)
+        den = np.where(flip, rc - sc, sb + rb)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            val = h * np.log(num / den)
+        val[~(np.abs(h) > 1e-14 * le)] = 0.0
+        out[sl] = val
     return out

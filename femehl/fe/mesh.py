@@ -450,7 +450,8 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
         A :data:`LADDER` name (``"coarse"``, ``"medium"``, ``"fine"``,
         ``"xfine"``); a path to any file meshio reads (only its ``triangle``
         cells are used, ``z`` is dropped); a :class:`skfem.MeshTri`; or a
-        :class:`DiskMesh` (returned as is if it passes the checks unchanged).
+        :class:`DiskMesh` (checked against ``L`` and ``half`` like any other
+        input, and returned as is if it passes the checks unchanged).
     L : float, default 2.0
         Disk radius the mesh must have.  For a ladder name with ``L != 2`` the
         mesh is generated with ``graded_disk(L=L, half=half, **LADDER[name])``
@@ -601,7 +602,10 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
             m = meshio.read(path, file_format=file_format)
     except (Exception, SystemExit) as exc:  # meshio raises many kinds: wrap them all
         said = " ".join(chatter.getvalue().split())
-        detail = f"{type(exc).__name__}: {exc}" if str(exc) else said or type(exc).__name__
+        if isinstance(exc, SystemExit) or not str(exc):
+            detail = said or type(exc).__name__
+        else:
+            detail = f"{type(exc).__name__}: {exc}"
         raise MeshError(
             f"cannot read mesh file '{path}' ({detail}); "
             f"pass a file in a format meshio reads, {_READABLE}"
@@ -618,13 +622,15 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
     if pts.ndim != 2 or pts.shape[1] < 2:
         raise MeshError(f"'{path}' has points of shape {pts.shape}; femehl needs x, y coordinates")
     if t.size and (t.min() < 0 or t.max() >= pts.shape[0]):
-        raise MeshError(f"'{path}' has triangles with node indices out of range; re-export the mesh")
+        raise MeshError(
+            f"'{path}' has triangles with node indices out of range; re-export the mesh"
+        )
     if pts.shape[1] > 2 and t.size:
         z = pts[np.unique(t), 2:]
         if np.all(np.isfinite(z)) and np.ptp(z, axis=0).max() > _RTOL_BOUNDARY * L:
             raise MeshError(
-                f"'{path}' is not planar (z varies by {np.ptp(z, axis=0).max():.3g}); femehl needs "
-                "a 2-D triangulation in the x-y plane"
+                f"'{path}' is not planar (z varies by {np.ptp(z, axis=0).max():.3g}); femehl "
+                "needs a 2-D triangulation in the x-y plane"
             )
     return pts[:, :2].T.copy(), t
 
@@ -672,9 +678,10 @@ def _normalize(p, t, L, half, name):
     degen = np.abs(a) <= _AREA_DEGENERATE * L * L
     if degen.any():
         e = np.flatnonzero(degen)[0]
+        cx, cy = p[0, t[:, e]].mean(), p[1, t[:, e]].mean()
         raise MeshError(
-            f"{where}: {degen.sum()} degenerate triangle(s) with area <= {_AREA_DEGENERATE:g} L^2, "
-            f"e.g. element {e} at ({p[0, t[:, e]].mean():.4g}, {p[1, t[:, e]].mean():.4g}); "
+            f"{where}: {degen.sum()} degenerate triangle(s) with area <= "
+            f"{_AREA_DEGENERATE:g} L^2, e.g. element {e} at ({cx:.4g}, {cy:.4g}); "
             "remove zero-area triangles or remesh"
         )
     # counterclockwise by signed area (never by node order)
@@ -772,7 +779,7 @@ def _normalize(p, t, L, half, name):
     rel = (A - A0) / A0
     if abs(rel) > rtol:
         hint = ""
-        if not half and abs(A - A0 / 2) <= rtol * A0 / 2:
+        if not half and abs(2 * A / A0 - 1) <= max(_AREA_RTOL_MIN, 4 * delta):
             hint = " (it looks like a half disk: pass half=True)"
         raise MeshError(
             f"{where}: the mesh does not cover the {'half ' if half else ''}disk of radius L = "
@@ -784,9 +791,9 @@ def _normalize(p, t, L, half, name):
         k = bnodes[off][0]
         raise MeshError(
             f"{where}: the mesh does not cover the disk: {off.sum()} boundary node(s) lie neither "
-            f"on r = L{' nor on y = 0' if half else ''}, e.g. ({p[0, k]:.6g}, {p[1, k]:.6g}); mesh "
-            f"the {'half disk r <= L, y >= 0' if half else 'disk r <= L'} with boundary nodes on "
-            "its boundary"
+            f"on r = L{' nor on y = 0' if half else ''}, e.g. ({p[0, k]:.6g}, {p[1, k]:.6g}); "
+            f"mesh the {'half disk r <= L, y >= 0' if half else 'disk r <= L'} with boundary "
+            "nodes on its boundary"
         )
 
     # snap: arc nodes exactly onto r = L, mirror nodes exactly onto y = 0

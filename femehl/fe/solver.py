@@ -36,7 +36,7 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, ElementTriP0, ElementTriP1, asm
 
 from ..errors import SceneError, SingularSystemError
-from ..kernels import influence_matrix, triangle_influence
+from ..kernels import edge_terms, mesh_edges, triangle_influence
 from ..scene import HalfSpace, Rigid, Scene, Winkler
 from ..stepping import State
 from .forms import couette, film_diffusion, squeeze
@@ -121,15 +121,25 @@ class FEDisc:
 
 # ---- elastic operators: w = -C p on elements ---------------------------------
 def _halfspace(substrate: HalfSpace, disc: FEDisc, free):
-    """Dense C[:, free] = c X P[:, free], X built in row blocks (no copy of X kept)."""
+    """Dense C[:, free] = c X P[:, free], built in row blocks.
+
+    X[i, j] = I(c_i, T_j) is never stored: with the signed edge incidence S
+    of :func:`femehl.kernels.mesh_edges`, X = T S where T holds one exact
+    term per unique edge, so a block of rows of C is T_block (S P).  For a
+    half disk the mirror images (orientation reversed) add -T_mirror S.
+    """
     ne = disc.nelements
-    Pf = disc.P[:, free].tocsc()
+    edges, S = mesh_edges(disc.mesh.t, disc.nodes)
+    SP = (S @ disc.P[:, free]).tocsc()                 # (nedges, nfree), sparse
+    mirror = disc.nodes * np.array([1.0, -1.0])
     C = np.empty((ne, free.size))
-    block = max(1, int(2**27 // (8 * ne)))          # ~128 MB of X rows at a time
+    block = max(1, int(2**26 // (8 * edges.shape[0])))
     for s in range(0, ne, block):
         e = slice(s, min(s + block, ne))
-        Xb = influence_matrix(disc.centroids[e], disc.tri, mirror_y=disc.half)
-        C[e] = (Pf.T @ Xb.T).T
+        T = edge_terms(disc.centroids[e], disc.nodes, edges)
+        if disc.half:
+            T -= edge_terms(disc.centroids[e], mirror, edges)
+        C[e] = (SP.T @ T.T).T
     C *= substrate.compliance
     return C
 

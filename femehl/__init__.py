@@ -1,0 +1,32 @@
+"""femehl: transient soft elastohydrodynamic lubrication, one linear system per step.
+
+Implements Wu, Hui et al., "Solving transient problems in soft
+elasto-hydrodynamic lubrication", JMPS 2022: a finite-element solver in
+scikit-fem (default) and the paper's polar finite-difference scheme (the
+reference).  Quick start::
+
+    import femehl
+    scene = femehl.presets.paper_sphere(beta=200.0, h0=0.1)
+    result = femehl.solve(scene, t_end=5.0, dt=0.01)          # FE, "medium" mesh
+    result.load, result.film_min                               # one entry per step
+    result.pressure_at([[0.0, 0.0], [-1.0, 0.0]], t=2.0)
+"""
+
+from . import presets
+from .api import SOLVERS, make_stepper, solve, steps
+from .errors import (FemehlError, FilmRuptureError, MeshError, SceneError, SceneFileError,
+                     SingularSystemError, SolverError)
+from .result import Result
+from .scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
+                    Scene, Sphere, Table, TanhStart, Winkler)
+from .stepping import State, march
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "presets", "solve", "steps", "make_stepper", "march", "SOLVERS", "Result", "State",
+    "Scene", "Sphere", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
+    "Dimensional", "Constant", "Table", "RampHold", "TanhStart",
+    "FemehlError", "SceneError", "SceneFileError", "MeshError", "SolverError",
+    "FilmRuptureError", "SingularSystemError",
+]

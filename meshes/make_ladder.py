@@ -59,7 +59,8 @@ def main() -> int:
             nbytes = path.stat().st_size
             if nbytes > MAX_BYTES:
                 path.unlink()
-                print(f"{name:<7} {kind:<6} skipped: {nbytes / 1e6:.1f} MB > {MAX_BYTES / 1e6:.0f} MB")
+                mb, cap = nbytes / 1e6, MAX_BYTES / 1e6
+                print(f"{name:<7} {kind:<6} skipped: {mb:.1f} MB > {cap:.0f} MB")
                 continue
             back = load_mesh(path, L=2.0, half=half)
             assert back.mesh.p.shape == dm.mesh.p.shape

@@ -1,0 +1,108 @@
+"""Command line: ``femehl run [SCENE.toml]`` (and ``femehl bench ...``).
+
+``femehl run`` without a file runs the built-in default: the paper's sphere
+(beta = 200, h0 = 0.1) to t = 5 with the FE solver on the "medium" mesh,
+which takes well under a minute here.  Options override the file's [run].
+Exit status: 0 done, 2 bad input, 3 the run stopped (film rupture,
+singular system) after writing what it had.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from .errors import FemehlError, SolverError
+
+DEFAULT_OUT = "femehl-out"
+
+
+def _parser():
+    p = argparse.ArgumentParser(prog="femehl", description="Transient soft-EHL solver (Wu, Hui et al. 2022).")
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run a scene (default: the paper's sphere) into an output folder")
+    r.add_argument("scene", nargs="?", help="TOML scene file (default: built-in paper case)")
+    r.add_argument("--method", choices=["fe", "fd"], help="solver (default fe)")
+    r.add_argument("--mesh", help="FE mesh: coarse|medium|fine|xfine or a mesh file (default medium)")
+    r.add_argument("--dr", type=float, help="FD radial step (default 0.025)")
+    r.add_argument("--dtheta-divisions", type=int, help="FD: dtheta = pi/N (default 24)")
+    r.add_argument("--dt", type=float, help="time step (default 0.01)")
+    r.add_argument("--t-end", type=float, help="end time (default 5)")
+    r.add_argument("--store-every", type=int, help="write fields every N steps (default 10)")
+    r.add_argument("--out", help=f"output folder (default {DEFAULT_OUT}/<scene name>)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
+    b.add_argument("what", choices=["accuracy", "stress"], help="which study")
+    b.add_argument("rest", nargs=argparse.REMAINDER)
+    return p
+
+
+def _run(args):
+    from . import presets
+    from .run import run_to_folder
+    from .scenefile import load_scene_file, run_options
+
+    if args.scene:
+        scene, run = load_scene_file(args.scene)
+        name = args.scene.rsplit("/", 1)[-1].rsplit(".", 1)[0]
+    else:
+        scene, run = presets.paper_sphere(), {}
+        name = "paper_sphere"
+    run = run_options(run)
+    for key in ("method", "mesh", "dr", "dt", "t_end", "store_every"):
+        v = getattr(args, key)
+        if v is not None:
+            run[key] = v
+    if args.dtheta_divisions is not None:
+        run["dtheta"] = math.pi / args.dtheta_divisions
+    method = run.pop("method", "fe")
+    if method == "fd":
+        run.setdefault("dr", 0.025)
+        run.setdefault("dtheta", math.pi / 24)
+        run.pop("mesh", None)
+        run.pop("linear_solver", None)
+    else:
+        run.setdefault("mesh", "medium")
+        for k in ("dr", "dtheta"):
+            if k in run:
+                raise FemehlError(f"{k} is an FD option; with method 'fe' give --mesh instead.")
+    out = args.out or f"{DEFAULT_OUT}/{name}"
+    res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
+                        store_every=run.pop("store_every", 10), progress=not args.quiet, **run)
+    print(f"femehl: done in {res.info['wall_s']:.1f} s; wrote {out}/summary.csv, fields.pvd, centreline.png, fields.png")
+    for t in sorted({1.0, float(res.t[-1])}):
+        if t <= res.t[-1] + 1e-9:
+            print(f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
+                  f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}")
+    return 0
+
+
+def _bench(args):
+    import runpy
+    import pathlib
+
+    root = pathlib.Path(__file__).resolve().parents[1] / "benchmarks"
+    script = root / f"{args.what}.py"
+    if not script.exists():
+        raise FemehlError(f"benchmark script {script} not found: benchmarks ship with the source "
+                          "checkout (git clone), not with an installed wheel.")
+    sys.argv = [str(script)] + list(args.rest)
+    runpy.run_path(str(script), run_name="__main__")
+    return 0
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return {"run": _run, "bench": _bench}[args.command](args)
+    except SolverError as exc:
+        print(f"femehl: error: {exc}", file=sys.stderr)
+        return 3
+    except FemehlError as exc:
+        print(f"femehl: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

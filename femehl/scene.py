@@ -261,14 +261,29 @@ class Motion:
         Tip clearance hc(t); hc > 0 is a gap, hc < 0 an indentation.
     velocity : callable or float, default: 0.0
         Sliding velocity V(t) in units of V_ss.
+    load : callable or float, optional
+        Imposed load F(t) = int p dA.  Then hc(t) is solved for at every step
+        (one more unknown, one more row: the step stays one linear system) and
+        ``gap`` only gives the initial clearance hc(0).
     """
 
     gap: Callable[[float], float] = field(default_factory=RampHold)
     velocity: Callable[[float], float] = field(default_factory=Constant)
+    load: Callable[[float], float] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "gap", _as_time_function("Motion gap hc(t)", self.gap))
         object.__setattr__(self, "velocity", _as_time_function("Motion velocity V(t)", self.velocity))
+        if self.load is not None:
+            object.__setattr__(self, "load", _as_time_function("Motion load F(t)", self.load))
+
+    @property
+    def load_controlled(self) -> bool:
+        """True when the load F(t) is imposed and hc(t) is an unknown (gap gives hc(0))."""
+        return self.load is not None
+
+    def F(self, t: float) -> float:
+        return check_finite(f"F(t={t:g})", self.load(t), "The load history must return finite values.")
 
     def hc(self, t: float) -> float:
         return check_finite(f"hc(t={t:g})", self.gap(t), "The gap history must return finite values.")
@@ -321,6 +336,8 @@ class Scene:
         if R is None:
             return
         gap = self.motion.gap
+        if self.motion.load_controlled:
+            return
         if isinstance(gap, RampHold):
             hmin = min(gap.h0, gap.h_end)
         elif isinstance(gap, Table):
@@ -343,6 +360,8 @@ class Scene:
         return any(self.motion.V(t) != 0.0 for t in ts)
 
     def has_squeeze(self, t_end: float, n: int = 2001) -> bool:
+        if self.motion.load_controlled:
+            return True
         ts = np.linspace(0.0, t_end, n)
         h = [self.motion.hc(t) for t in ts]
         return max(h) != min(h)
@@ -353,6 +372,7 @@ class Scene:
             "squeeze": self.has_squeeze(t_end),
             "sliding": self.has_sliding(t_end),
             "elasticity": self.substrate.kind,
+            "imposed_load": self.motion.load_controlled,
         }
 
 

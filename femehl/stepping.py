@@ -18,7 +18,7 @@ import numpy as np
 
 from .errors import FilmRuptureError, SceneError
 
-__all__ = ["State", "Stepper", "march", "check_run"]
+__all__ = ["State", "Stepper", "march", "check_run", "Scheme", "SCHEMES", "get_scheme"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +44,8 @@ class State:
     p_max: float
     p_max_at: tuple
     info: dict = field(default_factory=dict)
+    d_prev: np.ndarray | None = None      # d one step earlier (two-step schemes)
+    dt_prev: float | None = None          # the step that led to this state
 
 
 class Stepper(Protocol):
@@ -68,17 +70,57 @@ def check_run(t_end, dt):
     return t_end, dt, n
 
 
-def march(stepper: Stepper, t_end: float, dt: float) -> Iterator[State]:
+@dataclass(frozen=True)
+class Scheme:
+    """A time discretization that keeps ONE linear system per step.
+
+    The film's time derivative is ``(a0 d^{k+1} - a1 d^k + a2 d^{k-1}) / dt`` and the
+    lagged coefficients use ``d* = l0 d^k - l1 d^{k-1}``, with coefficients depending on
+    the step ratio ``omega = dt / dt_prev`` (variable-step formulas).
+    """
+
+    name: str
+    order: int
+
+    def coefficients(self, omega: float | None):
+        """``(a0, a1, a2, l0, l1)`` for step ratio ``omega`` (None: first step)."""
+        if self.order == 1 or omega is None:
+            return 1.0, 1.0, 0.0, 1.0, 0.0
+        w = omega
+        return (1 + 2 * w) / (1 + w), 1 + w, w * w / (1 + w), 1 + w, w
+
+
+#: "euler": the paper's scheme (backward Euler in d_t, coefficients lagged one step);
+#: "bdf2": BDF2 in d_t with coefficients extrapolated linearly from two steps.
+SCHEMES = {"euler": Scheme("euler", 1), "bdf2": Scheme("bdf2", 2)}
+
+
+def get_scheme(name: str) -> Scheme:
+    if name not in SCHEMES:
+        raise SceneError(f"unknown time scheme {name!r}: choose one of {sorted(SCHEMES)}.")
+    return SCHEMES[name]
+
+
+def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None) -> Iterator[State]:
     """Yield the initial state, then one :class:`State` per step up to ``t_end``.
 
-    The last step is shortened so the run ends exactly at ``t_end``.  A film
+    The last step is shortened so the run ends exactly at ``t_end``.  With ``start``
+    (a State of an earlier run, e.g. from a checkpoint) the run continues from it.  A film
     thickness reaching zero raises :class:`~femehl.errors.FilmRuptureError`
     from the step that produced it (everything yielded before stays valid).
     """
     t_end, dt, n = check_run(t_end, dt)
-    state = stepper.initial_state()
+    if start is None:
+        state = stepper.initial_state()
+        k0 = 0
+    else:
+        state = start
+        k0 = int(round(start.t / dt))
+        if abs(k0 * dt - start.t) > 1e-9 * max(1.0, start.t):
+            raise SceneError(f"cannot resume at t = {start.t:g} with dt = {dt:g}: "
+                             "resume with the dt of the original run.")
     yield state
-    for k in range(1, n + 1):
+    for k in range(k0 + 1, n + 1):
         t_new = min(k * dt, t_end)
         h = t_new - state.t
         if h <= 1e-14:

@@ -38,7 +38,7 @@ from skfem import Basis, ElementTriP0, ElementTriP1, asm
 from ..errors import SceneError, SingularSystemError
 from ..kernels import edge_terms, mesh_edges, triangle_influence
 from ..scene import HalfSpace, Rigid, Scene, Winkler
-from ..stepping import State
+from ..stepping import State, get_scheme
 from .forms import couette, film_diffusion, squeeze
 from .mesh import DiskMesh, load_mesh
 
@@ -169,8 +169,7 @@ def compliance_operator(substrate, disc, free):
 @dataclass
 class _Factor:
     lu: tuple
-    dt: float
-    V: float
+    key: float          # a0/dt of the factorized matrix
 
 
 class FEStepper:
@@ -183,6 +182,9 @@ class FEStepper:
         A ladder name ("coarse", "medium", "fine", "xfine") or any mesh meshio reads.
     half : bool, optional
         Use the half disk y >= 0; default: True when the indenter is symmetric in y.
+    scheme : {"euler", "bdf2"}, default: "euler"
+        "euler" is the paper's first-order scheme; "bdf2" is second order and
+        still one linear system per step (see :data:`femehl.stepping.SCHEMES`).
     linear_solver : {"gmres", "lu"}, default: "gmres"
         "gmres": GMRES preconditioned by the LU of a recent step; "lu": a new
         dense LU at every step.
@@ -195,9 +197,11 @@ class FEStepper:
     method = "fe"
 
     def __init__(self, scene: Scene, mesh="medium", half: bool | None = None,
-                 linear_solver: str = "gmres", rtol: float = 1e-10, refactor_after: int = 8):
+                 scheme: str = "euler", linear_solver: str = "gmres", rtol: float = 1e-10,
+                 refactor_after: int = 8):
         t0 = time.perf_counter()
         self.scene = scene
+        self.scheme = get_scheme(scheme)
         symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
         if half is None:
             half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
@@ -210,45 +214,48 @@ class FEStepper:
                              "in y: use a full-disk mesh.")
         if linear_solver not in ("gmres", "lu"):
             raise SceneError(f"linear_solver must be 'gmres' or 'lu', got {linear_solver!r}.")
-        if not (0.0 < float(rtol) < 1e-2):
+        try:
+            rtol = float(rtol)
+        except (TypeError, ValueError):
+            rtol = float("nan")
+        if not (0.0 < rtol < 1e-2):
             raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
         self.linear_solver = linear_solver
-        self.rtol = float(rtol)
+        self.rtol = rtol
         self.refactor_after = int(refactor_after)
         self.disc = disc = FEDisc(dm)
         free = disc.free
         self.free = free
         self.beta = scene.fluid.beta
         self.shape = np.asarray(scene.indenter.gap(disc.centroids[:, 0], disc.centroids[:, 1]), float)
+        if self.shape.shape != (disc.nelements,) or not np.all(np.isfinite(self.shape)):
+            raise SceneError("the indenter's gap(x, y) must return finite values of the same shape "
+                             "as x; check the shape function.")
         b1, b0 = disc.basis, disc.basis0
         # element stiffness with unit coefficient; K(d) scales each element by d^3
         kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(disc.nelements)))
         self._k_rows, self._k_cols = kcoo.indices
         self._k_data = kcoo.data.reshape(-1, disc.nelements)       # (9, ne), element last
-        self.Bx = asm(couette, b0, b1).tocsr()[free]                 # (nfree, ne)
-        self.M = asm(squeeze, b0, b1).tocsr()[free]
-        self.node_weight = np.asarray(asm(squeeze, b0, b1).sum(axis=1)).ravel()  # int phi_q dA
+        Mfull = asm(squeeze, b0, b1).tocsr()
+        self.M = Mfull[free]                                         # (nfree, ne)
+        self.node_weight = np.asarray(Mfull.sum(axis=1)).ravel()     # int phi_q dA
         self.mult = 2.0 if disc.half else 1.0
         t1 = time.perf_counter()
         self.C = compliance_operator(scene.substrate, disc, free)
         self.dense = isinstance(self.C, np.ndarray)
         t2 = time.perf_counter()
-        if self.dense:
-            self.BxC = np.asarray(self.Bx @ self.C)
-            self.MC = np.asarray(self.M @ self.C)
-        else:
-            self.BxC = sp.csr_matrix(self.Bx @ self.C)
-            self.MC = sp.csr_matrix(self.M @ self.C)
-        # exact deflection at the centre: one kernel row, for film_center
+        self.MC = np.asarray(self.M @ self.C) if self.dense else sp.csr_matrix(self.M @ self.C)
+        self._Bx = None        # Couette operators: built the first time V != 0
+        self._BxC = None
         self._centre_row = self._centre_operator()
         self._factor: _Factor | None = None
         self.info = {
             "method": "fe", "mesh": dm.name, "half": dm.half, "elements": disc.nelements,
-            "nodes": disc.nnodes, "unknowns": int(free.size),
+            "nodes": disc.nnodes, "unknowns": int(free.size), "scheme": self.scheme.name,
             "substrate": type(scene.substrate).__name__,
             "setup_s": time.perf_counter() - t0, "elastic_build_s": t2 - t1,
-            "operator_bytes": int(_nbytes(self.C) + _nbytes(self.BxC) + _nbytes(self.MC)),
-            "factorizations": 0, "krylov_iterations": 0,
+            "operator_bytes": int(_nbytes(self.C) + _nbytes(self.MC)),
+            "factorizations": 0, "krylov_iterations": 0, "couette_assembled": False,
         }
 
     def _centre_operator(self):
@@ -260,58 +267,75 @@ class FEStepper:
         return None
 
     # ---- operators ----------------------------------------------------------
+    def couette(self):
+        """(Bx, Bx C): assembled once, the first time the scene slides."""
+        if self._Bx is None:
+            self._Bx = asm(couette, self.disc.basis0, self.disc.basis).tocsr()[self.free]
+            self._BxC = (np.asarray(self._Bx @ self.C) if self.dense
+                         else sp.csr_matrix(self._Bx @ self.C))
+            self.info["couette_assembled"] = True
+            self.info["operator_bytes"] += _nbytes(self._BxC)
+        return self._Bx, self._BxC
+
     def stiffness(self, d: np.ndarray):
-        """K(d^k) on the free nodes, element coefficient (d^k)^3."""
+        """K(d) on the free nodes, element coefficient d^3."""
         data = (self._k_data * (d ** 3)[None, :]).ravel()
         n = self.disc.nnodes
         K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
         return K[self.free][:, self.free]
 
-    def _matrix(self, K, V, dt):
+    def _matrix(self, K, V, c):
+        """A = beta K + V Bx C + c M C, with c = a0/dt."""
         if self.dense:
             A = self.beta * K.toarray()
-            A += V * self.BxC
-            A += self.MC / dt
+            if V != 0.0:
+                A += V * self.couette()[1]
+            A += c * self.MC
             return A
-        return (self.beta * K + V * self.BxC + self.MC / dt).tocsc()
+        A = self.beta * K + c * self.MC
+        if V != 0.0:
+            A = A + V * self.couette()[1]
+        return A.tocsc()
 
-    def _solve(self, K, V, dt, rhs, t_new):
+    def _solve(self, K, V, c, rhs, t_new):
         bnorm = float(np.linalg.norm(rhs))
         if bnorm == 0.0:
             return np.zeros_like(rhs), 0
         if not self.dense:
-            A = self._matrix(K, V, dt)
-            return spla.spsolve(A, rhs), 0
+            return spla.spsolve(self._matrix(K, V, c), rhs), 0
         if self.linear_solver == "lu":
-            return self._direct(K, V, dt, rhs, t_new), 0
+            self._factor = None
         f = self._factor
-        if f is None or abs(f.dt - dt) > 1e-9 * dt:
-            return self._direct(K, V, dt, rhs, t_new), 0
+        if f is None or abs(f.key - c) > 1e-9 * c:
+            return self._direct(K, V, c, rhs, t_new), 0
+        BxC = self.couette()[1] if V != 0.0 else None
 
         def matvec(x):
-            return self.beta * (K @ x) + self.BxC @ (V * x) + self.MC @ (x / dt)
+            y = self.beta * (K @ x) + self.MC @ (c * x)
+            if BxC is not None:
+                y += BxC @ (V * x)
+            return y
 
         n = rhs.size
         A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
         Minv = spla.LinearOperator((n, n), matvec=lambda x: sla.lu_solve(f.lu, x), dtype=float)
-        x0 = sla.lu_solve(f.lu, rhs)
         its = [0]
 
         def count(_):
             its[0] += 1
 
-        x, flag = spla.gmres(A, rhs, x0=x0, rtol=self.rtol, atol=0.0, M=Minv, restart=30,
-                             maxiter=3, callback=count, callback_type="pr_norm")
+        x, flag = spla.gmres(A, rhs, x0=sla.lu_solve(f.lu, rhs), rtol=self.rtol, atol=0.0, M=Minv,
+                             restart=30, maxiter=3, callback=count, callback_type="pr_norm")
         res = np.linalg.norm(rhs - matvec(x)) / bnorm
         self.info["krylov_iterations"] += its[0]
         if flag != 0 or not np.isfinite(res) or res > 10 * self.rtol:
-            return self._direct(K, V, dt, rhs, t_new), its[0]
+            return self._direct(K, V, c, rhs, t_new), its[0]
         if its[0] > self.refactor_after:
             self._factor = None          # refresh at the next step
         return x, its[0]
 
-    def _direct(self, K, V, dt, rhs, t_new):
-        A = self._matrix(K, V, dt)
+    def _direct(self, K, V, c, rhs, t_new):
+        A = self._matrix(K, V, c)
         try:
             lu = sla.lu_factor(A, overwrite_a=True, check_finite=True)
         except (ValueError, np.linalg.LinAlgError) as exc:
@@ -320,14 +344,13 @@ class FEStepper:
         if np.any(np.abs(np.diag(lu[0])) == 0.0):
             raise SingularSystemError(
                 f"FE step at t = {t_new:.6g}: the linear system is singular (zero pivot). "
-                "Check the scene (a rigid substrate needs a squeeze or sliding term) or try a "
-                "smaller dt.", t=t_new)
-        self._factor = _Factor(lu, dt, V)
+                "Try a smaller dt or a finer mesh.", t=t_new)
+        self._factor = _Factor(lu, c)
         self.info["factorizations"] += 1
         return sla.lu_solve(lu, rhs)
 
     # ---- stepping -----------------------------------------------------------
-    def _state(self, step, t, hc, V, p_free, info=None):
+    def _state(self, step, t, hc, V, p_free, d_prev=None, dt_prev=None, info=None):
         disc = self.disc
         p = np.zeros(disc.nnodes)
         p[self.free] = p_free
@@ -345,24 +368,56 @@ class FEStepper:
         return State(step=step, t=t, hc=hc, V=V, p=p, w=w, d=d, load=load,
                      film_center=hc + s0 - w0, film_min=float(d[i_min]),
                      film_min_at=tuple(disc.centroids[i_min]), p_max=float(p[i_max]),
-                     p_max_at=tuple(disc.nodes[i_max]), info=info or {})
+                     p_max_at=tuple(disc.nodes[i_max]), info=info or {},
+                     d_prev=d_prev, dt_prev=dt_prev)
 
     def initial_state(self) -> State:
         mo = self.scene.motion
         return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.free.size))
 
     def step(self, state: State, t_new: float, dt: float) -> State:
+        """One lagged step: ONE linear system (bordered by one row under imposed load)."""
         mo = self.scene.motion
-        hc, V = mo.hc(t_new), mo.V(t_new)
-        h = hc + self.shape
-        K = self.stiffness(state.d)
-        rhs = -V * (self.Bx @ h) - self.M @ (h - state.d) / dt
-        p, its = self._solve(K, V, dt, rhs, t_new)
-        if not np.all(np.isfinite(p)):
+        V = mo.V(t_new)
+        omega = None if state.d_prev is None else dt / state.dt_prev
+        a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
+        d_lag = state.d if l1 == 0.0 else np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
+        hist = a1 * state.d - (a2 * state.d_prev if a2 else 0.0)   # a1 d^k - a2 d^{k-1}
+        K = self.stiffness(d_lag)
+        c = a0 / dt
+        Bx = self.couette()[0] if V != 0.0 else None
+
+        def rhs_for(h):
+            r = -self.M @ (a0 * h - hist) / dt
+            if Bx is not None:
+                r -= V * (Bx @ h)
+            return r
+
+        if mo.load_controlled:
+            # A p + col hc = rhs(s);  g . p = F   ->  p = x1 - hc x2
+            F = mo.F(t_new)
+            x1, its1 = self._solve(K, V, c, rhs_for(self.shape), t_new)
+            col = c * (self.M @ np.ones(self.disc.nelements))
+            if Bx is not None:
+                col += V * (Bx @ np.ones(self.disc.nelements))
+            x2, its2 = self._solve(K, V, c, col, t_new)
+            g = self.mult * self.node_weight[self.free]
+            den = float(g @ x2)
+            if not np.isfinite(den) or den == 0.0:
+                raise SingularSystemError(f"FE step at t = {t_new:.6g}: the load row is singular "
+                                          "(the film does not respond to hc).", t=t_new)
+            hc = (float(g @ x1) - F) / den
+            p = x1 - hc * x2
+            its = its1 + its2
+        else:
+            hc = mo.hc(t_new)
+            p, its = self._solve(K, V, c, rhs_for(hc + self.shape), t_new)
+        if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"FE step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
                 "or ill-conditioned. Try a smaller dt or a finer mesh.", t=t_new)
-        return self._state(state.step + 1, t_new, hc, V, p, info={"krylov_iterations": its})
+        return self._state(state.step + 1, t_new, hc, V, p, d_prev=state.d, dt_prev=dt,
+                           info={"krylov_iterations": its})
 
 
 def _nbytes(a) -> int:

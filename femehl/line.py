@@ -44,10 +44,14 @@ Imposed load per unit length ``F(t)`` instead of an imposed gap: hc^{k+1} is
 one more unknown (its column is ``V Bx 1 + M 1/dt``) and the row
 ``int p dx = F(t^{k+1})`` borders the system; still one sparse solve per step,
 and the load is met to solver precision at every step.  ``motion.gap`` then
-only sets the initial clearance hc(0).
+only sets the initial clearance hc(0) (as for the 2-D solvers).
 
-At a steady state (d^{k+1} = d^k) the scheme reduces to the steady weak form
-whatever dt, so long runs test the spatial discretization alone.
+``scheme="bdf2"`` (see :data:`femehl.stepping.SCHEMES`) replaces the backward
+Euler difference by BDF2 and the lagged d^k by the extrapolation
+``2 d^k - d^{k-1}`` (variable-step forms); still one linear system per step.
+At a steady state (d^{k+1} = d^k = d^{k-1}) either scheme reduces to the
+steady weak form whatever dt, so long runs test the spatial discretization
+alone.
 """
 
 from __future__ import annotations
@@ -66,7 +70,7 @@ from .errors import SceneError, SingularSystemError
 from .fe.forms import couette, film_diffusion, squeeze
 from .scene import (Constant, Motion, RampHold, Table, TanhStart, _as_time_function,
                     check_finite, check_positive)
-from .stepping import State, march
+from .stepping import State, get_scheme, march
 
 __all__ = ["LineScene", "LineStepper", "LineResult", "line_nodes", "solve_line"]
 
@@ -90,12 +94,12 @@ class LineScene:
         The paper's film parameter multiplying ``d/dx(d^3 dp/dx)`` (> 0).
     motion : femehl.scene.Motion, default: ramp 0.1 -> -0.5 for t <= 1, then tanh(t - 1) sliding
         Tip clearance hc(t) and sliding velocity V(t) (cylinder moves toward +x).
-        With an imposed ``load``, ``motion.gap`` must be a constant: the initial
-        clearance hc(0).
+        With an imposed load, ``motion.gap`` only gives the initial clearance hc(0).
     L : float, default: 2.0
         Half length of the domain ``[-L, L]``; p = 0 at both ends.
     load : callable or float or None, default: None
-        Imposed load per unit length ``F(t) = int p dx``; None imposes the gap instead.
+        Imposed load per unit length ``F(t) = int p dx``; None imposes the gap
+        instead.  ``motion.load`` is accepted too (and moved here); give one of them.
     """
 
     k: float = 1.0
@@ -115,14 +119,15 @@ class LineScene:
             raise SceneError(
                 f"LineScene.motion must be a femehl.scene.Motion, got {type(self.motion).__name__}: "
                 "wrap the gap and velocity as Motion(gap=..., velocity=...).")
+        mload = getattr(self.motion, "load", None)
+        if mload is not None:
+            if self.load is not None:
+                raise SceneError(
+                    "the load is imposed twice (LineScene.load and Motion.load): give only one.")
+            object.__setattr__(self, "load", mload)
         if self.load is not None:
             object.__setattr__(self, "load", _as_time_function("LineScene load F(t)", self.load))
             check_finite("load F(t=0)", self.load(0.0), "The load history must return finite values.")
-            if not isinstance(self.motion.gap, Constant):
-                raise SceneError(
-                    "with an imposed load the clearance hc(t) is an unknown, so motion.gap only "
-                    f"sets hc(0); got a {type(self.motion.gap).__name__}. Pass the initial "
-                    "clearance as a number, e.g. Motion(gap=0.1, velocity=...).")
         hc0 = self.motion.hc(0.0)
         if hc0 <= 0.0:
             raise SceneError(
@@ -254,6 +259,9 @@ class LineStepper:
     fine : float, optional
         Half width of the fine zone; default ``min(L, a + 0.5)`` with ``a`` the
         dry contact half width (:meth:`LineScene.contact_halfwidth`), or ``L/2``.
+    scheme : {"euler", "bdf2"}, default: "euler"
+        "euler" is the paper's scheme (backward Euler, d^3 lagged one step);
+        "bdf2" is second order in time (:data:`femehl.stepping.SCHEMES`).
 
     Attributes
     ----------
@@ -268,11 +276,13 @@ class LineStepper:
     method = "line"
     matrix_format = "csc"
 
-    def __init__(self, scene: LineScene, n_elements: int = 400, grading=3.0, fine=None):
+    def __init__(self, scene: LineScene, n_elements: int = 400, grading=3.0, fine=None,
+                 scheme: str = "euler"):
         t0 = time.perf_counter()
         if not isinstance(scene, LineScene):
             raise SceneError(f"scene must be a femehl.line.LineScene, got {type(scene).__name__}.")
         self.scene = scene
+        self.scheme = get_scheme(scheme)
         if fine is None and not isinstance(grading, str):
             a = scene.contact_halfwidth()
             fine = 0.5 * scene.L if a is None else min(scene.L, a + 0.5)
@@ -310,7 +320,8 @@ class LineStepper:
             "method": self.method, "elements": ne, "nodes": nn, "unknowns": int(free.size)
             + int(scene.imposed_load), "grading": grading if not callable(grading) else "callable",
             "h_min": float(np.diff(self.x).min()), "h_max": float(np.diff(self.x).max()),
-            "imposed_load": scene.imposed_load, "setup_s": time.perf_counter() - t0,
+            "imposed_load": scene.imposed_load, "scheme": self.scheme.name,
+            "setup_s": time.perf_counter() - t0,
         }
 
     # ---- operators ----------------------------------------------------------
@@ -325,26 +336,37 @@ class LineStepper:
         """The sparse system ``A u = b`` of the step from ``state`` to ``t_new``.
 
         ``u`` is the free nodal pressure, followed by hc^{k+1} under an imposed
-        load.  ``A`` is a scipy sparse matrix in :attr:`matrix_format`.
+        load.  ``A`` is a scipy sparse matrix in :attr:`matrix_format`.  With
+        the scheme's coefficients (Euler: a0 = a1 = l0 = 1, a2 = l1 = 0)
+
+            A = beta K(l0 d^k - l1 d^{k-1}) + V Bx C + (a0/dt) M C
+            b = -V Bx h - M (a0 h - a1 d^k + a2 d^{k-1}) / dt.
         """
         sc = self.scene
         V = sc.motion.V(t_new)
-        K = self.stiffness(state.d)
-        A = self.beta * K + V * self.BxC + self.MC / dt
+        omega = None if state.d_prev is None or not state.dt_prev else dt / state.dt_prev
+        a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
+        if l1 == 0.0:
+            d_lag, hist = state.d, state.d
+        else:   # extrapolated coefficient, kept positive as in the FE solver
+            d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
+            hist = a1 * state.d - a2 * state.d_prev
+        c = a0 / dt
+        A = self.beta * self.stiffness(d_lag) + V * self.BxC + c * self.MC
         if not sc.imposed_load:
             h = sc.motion.hc(t_new) + self.shape
-            b = -V * (self.Bx @ h) - self.M @ (h - state.d) / dt
+            b = -V * (self.Bx @ h) - self.M @ (a0 * h - hist) / dt
             return A.asformat(self.matrix_format), b
         F = check_finite(f"load F(t={t_new:g})", sc.load(t_new),
                          "The load history must return finite values.")
-        col = V * self._hc_col[0] + self._hc_col[1] / dt
+        col = V * self._hc_col[0] + c * self._hc_col[1]
         row = self.node_weight[self.free]
         A = sp.bmat([[A, sp.csr_matrix(col[:, None])], [sp.csr_matrix(row[None, :]), None]])
-        b = np.concatenate([-V * (self.Bx @ self.shape) - self.M @ (self.shape - state.d) / dt, [F]])
+        b = np.concatenate([-V * (self.Bx @ self.shape) - self.M @ (a0 * self.shape - hist) / dt, [F]])
         return A.asformat(self.matrix_format), b
 
     # ---- stepping -----------------------------------------------------------
-    def _state(self, step, t, hc, V, p_free, info=None) -> State:
+    def _state(self, step, t, hc, V, p_free, info=None, d_prev=None, dt_prev=None) -> State:
         p = np.zeros(self.nnodes)
         p[self.free] = p_free
         Pp = self.P @ p
@@ -356,7 +378,7 @@ class LineStepper:
                      load=float(self.node_weight @ p), film_center=float(hc) + p0 / self.k,
                      film_min=float(d[i_min]), film_min_at=(float(self.xc[i_min]), 0.0),
                      p_max=float(p[i_max]), p_max_at=(float(self.x[i_max]), 0.0),
-                     info=info or {})
+                     info=info or {}, d_prev=d_prev, dt_prev=dt_prev)
 
     def initial_state(self) -> State:
         """p = 0 at t = 0, so d = hc(0) + x^2/2."""
@@ -384,7 +406,7 @@ class LineStepper:
         else:
             p_free, hc = u, mo.hc(t_new)
         return self._state(state.step + 1, t_new, hc, mo.V(t_new), p_free,
-                           info={"residual": res})
+                           info={"residual": res}, d_prev=state.d, dt_prev=dt)
 
 
 # --------------------------------------------------------------------------
@@ -443,7 +465,7 @@ def solve_line(scene: LineScene, t_end: float, dt: float, *, store_every: int = 
     callback : callable, optional
         Called with every state as it is produced.
     **opts
-        Passed to :class:`LineStepper` (``n_elements``, ``grading``, ``fine``).
+        Passed to :class:`LineStepper` (``n_elements``, ``grading``, ``fine``, ``scheme``).
 
     Returns
     -------

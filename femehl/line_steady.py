@@ -105,7 +105,7 @@ def _shoot(k, beta, hc, L, V, d_star, method, rtol, dense=False):
                      atol=rtol * 1e-2 * min(1.0, d0), dense_output=dense)
 
 
-def _solve(k, beta, hc, L, V, method, rtol) -> SteadyLine:
+def _solve(k, beta, hc, L, V, method, rtol, guess=None) -> SteadyLine:
     d0 = hc + 0.5 * L * L
 
     def miss(ds):
@@ -115,8 +115,14 @@ def _solve(k, beta, hc, L, V, method, rtol) -> SteadyLine:
         return s.y[0, -1] - d0
 
     # d(L) grows with d_*: d_* = d0 overshoots; halve from there until it undershoots
-    hi, mhi = d0, miss(d0)
-    lo, mlo = 0.5 * d0, miss(0.5 * d0)
+    if guess is not None and 0.0 < guess < d0:
+        lo, hi = 0.99 * guess, min(1.01 * guess, d0)
+        mlo, mhi = miss(lo), miss(hi)
+        if not (mlo < 0.0 < mhi):
+            guess = None
+    if guess is None or not 0.0 < guess < d0:
+        hi, mhi = d0, miss(d0)
+        lo, mlo = 0.5 * d0, miss(0.5 * d0)
     while mlo >= 0.0 and lo > 1e-6 * d0:
         hi, mhi = lo, mlo
         lo *= 0.5
@@ -196,10 +202,17 @@ def steady_line_load(k: float, beta: float, F: float, L: float, V: float = 1.0, 
         a = (1.5 * F / k) ** (1.0 / 3.0)
         hc_bracket = (max(-0.5 * a * a - 1.0, -0.49 * L * L), 0.25 * L * L)
     lo, hi = (float(v) for v in hc_bracket)
-    g = lambda hc: _solve(k, beta, hc, L, V, method, rtol).load - F  # noqa: E731
+    last = {}
+
+    def g(hc):
+        s = _solve(k, beta, hc, L, V, method, rtol, guess=last.get("d_star"))
+        last["d_star"], last[hc] = s.d_star, s
+        return s.load - F
+
     glo, ghi = g(lo), g(hi)
     if not (glo > 0.0 > ghi):
         raise SolverError(f"steady_line_load: F = {F:g} is not bracketed by hc in ({lo:g}, {hi:g}) "
                           f"(load - F = {glo:.3g}, {ghi:.3g}); pass hc_bracket.")
-    hc = brentq(g, lo, hi, xtol=1e-13, rtol=1e-13)
-    return _solve(k, beta, hc, L, V, method, rtol)
+    # the load is computed to about rtol, so hc is not worth more digits than that
+    hc = brentq(g, lo, hi, xtol=max(1e-13, 10 * rtol), rtol=1e-13)
+    return last[hc] if hc in last else _solve(k, beta, hc, L, V, method, rtol, guess=last["d_star"])

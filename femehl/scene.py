@@ -171,31 +171,9 @@ def _as_time_function(name: str, f) -> Callable[[float], float]:
 
 
 # --------------------------------------------------------------------------
-# indenters
+# indenters: defined in femehl.indenters (Sphere stays importable from here)
 # --------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Sphere:
-    """A rigid sphere (paraboloid near its tip): ``s(x, y) = (x^2 + y^2) / (2 R)``.
-
-    Parameters
-    ----------
-    R : float, default: 1.0
-        Radius in units of the normalization length ``sqrt(R* h_inf)/sqrt(R*/h_inf)``;
-        the paper's normalization makes it 1.
-    """
-
-    R: float = 1.0
-    symmetric_y = True
-    axisymmetric = True
-
-    def __post_init__(self):
-        check_positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization.")
-
-    def gap(self, x, y):
-        """Rigid gap shape s(x, y) (>= 0, zero at the tip), broadcast over arrays."""
-        x = np.asarray(x, dtype=float)
-        y = np.asarray(y, dtype=float)
-        return (x * x + y * y) / (2.0 * self.R)
+from .indenters import Sphere  # noqa: E402  (after the helpers it uses lazily)
 
 
 # --------------------------------------------------------------------------

@@ -108,6 +108,15 @@ class PolarGrid:
     def deflection_at(self, w, points):
         return self._interp(w, points, np.nan)
 
+    def vtk_geometry(self):
+        """Points (z = 0), quad cells of the grid, and True: FD fields live on nodes."""
+        m, n = self.m, self.n
+        pts = np.column_stack([self.xy(), np.zeros(m * n)])
+        I, J = np.meshgrid(np.arange(m - 1), np.arange(n - 1), indexing="ij")
+        a = (I * n + J).ravel()
+        quads = np.column_stack([a, a + 1, a + n + 1, a + n]).astype(np.int64)
+        return pts, [("quad", quads)], True
+
     def centreline(self):
         """Node indices and x of the line y = 0 from x = -L to L: (idx, x)."""
         m, n = self.m, self.n

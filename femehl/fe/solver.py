@@ -114,6 +114,12 @@ class FEDisc:
     def deflection_at(self, w, points):
         return self._cell_value(w, points)
 
+    def vtk_geometry(self):
+        """Points (z = 0), triangles, and False: film fields live on elements."""
+        p = self.mesh.p
+        pts = np.column_stack([p[0], p[1], np.zeros(p.shape[1])])
+        return pts, [("triangle", self.mesh.t.T.astype(np.int64))], False
+
     def centreline(self, n: int = 401):
         x = np.linspace(-self.L, self.L, n)
         return np.column_stack([x, np.zeros_like(x)])

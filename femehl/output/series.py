@@ -22,18 +22,11 @@ __all__ = ["SeriesWriter", "grid_cells"]
 
 
 def grid_cells(disc):
-    """(points (n, 3), [(cell type, connectivity)], point-field flag) of a discretization."""
-    if hasattr(disc, "mesh"):                          # FE disk mesh
-        p = disc.mesh.p
-        pts = np.column_stack([p[0], p[1], np.zeros(p.shape[1])])
-        return pts, [("triangle", disc.mesh.t.T.astype(np.int64))], False
-    m, n = disc.m, disc.n                               # FD polar grid
-    xy = disc.xy()
-    pts = np.column_stack([xy, np.zeros(xy.shape[0])])
-    I, J = np.meshgrid(np.arange(m - 1), np.arange(n - 1), indexing="ij")
-    a = (I * n + J).ravel()
-    quads = np.column_stack([a, a + 1, a + n + 1, a + n])
-    return pts, [("quad", quads.astype(np.int64))], True
+    """(points (n, 3), [(cell type, connectivity)], fields-on-nodes flag) of a discretization.
+
+    Each discretization describes its own geometry (``disc.vtk_geometry()``).
+    """
+    return disc.vtk_geometry()
 
 
 class SeriesWriter:

@@ -12,10 +12,11 @@ reference).  Quick start::
     result.pressure_at([[0.0, 0.0], [-1.0, 0.0]], t=2.0)
 """
 
-from . import presets
+from . import indenters, presets
 from .api import SOLVERS, make_stepper, solve, steps
 from .errors import (FemehlError, FilmRuptureError, MeshError, SceneError, SceneFileError,
                      SingularSystemError, SolverError)
+from .indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
 from .result import Result
 from .scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
                     Scene, Sphere, Table, TanhStart, Winkler)
@@ -24,8 +25,8 @@ from .stepping import State, march
 __version__ = "0.1.0"
 
 __all__ = [
-    "presets", "solve", "steps", "make_stepper", "march", "SOLVERS", "Result", "State",
-    "Scene", "Sphere", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
+    "presets", "indenters", "solve", "steps", "make_stepper", "march", "SOLVERS", "Result", "State",
+    "Scene", "Sphere", "Ellipsoid", "FlatPunch", "Shape", "HeightMap", "INDENTERS", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
     "Dimensional", "Constant", "Table", "RampHold", "TanhStart",
     "FemehlError", "SceneError", "SceneFileError", "MeshError", "SolverError",
     "FilmRuptureError", "SingularSystemError",

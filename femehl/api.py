@@ -94,7 +94,6 @@ def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: fl
         raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
     stepper = make_stepper(scene, method, **options)
     result = Result(scene=scene, method=stepper.method, disc=stepper.disc)
-    result.info.update(getattr(stepper, "info", {}))
     last = None
     for state in march(stepper, t_end, dt):
         keep = store_every > 0 and state.step % store_every == 0
@@ -104,4 +103,5 @@ def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: fl
         last = (state, keep)
     if last is not None and store_every > 0 and not last[1]:
         result._stored.append(last[0])
+    result.info.update(getattr(stepper, "info", {}))      # counters as at the end of the run
     return result

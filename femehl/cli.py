@@ -32,6 +32,8 @@ def _parser():
     r.add_argument("--store-every", type=int, help="write fields every N steps (default 10)")
     r.add_argument("--out", help=f"output folder (default {DEFAULT_OUT}/<scene name>)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--resume", action="store_true",
+                   help="continue the run in the output folder from its checkpoint.npz")
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument("what", choices=["accuracy", "stress"], help="which study")
     b.add_argument("rest", nargs=argparse.REMAINDER)
@@ -43,8 +45,10 @@ def _run(args):
     from .run import run_to_folder
     from .scenefile import load_scene_file, run_options
 
+    dim = None
     if args.scene:
         scene, run = load_scene_file(args.scene)
+        dim = run.pop("_dimensional", None)      # the scene was stated in SI units
         name = args.scene.rsplit("/", 1)[-1].rsplit(".", 1)[0]
     else:
         scene, run = presets.paper_sphere(), {}
@@ -69,13 +73,32 @@ def _run(args):
                 raise FemehlError(f"{k} is an FD option; with method 'fe' give --mesh instead.")
     out = args.out or f"{DEFAULT_OUT}/{name}"
     res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
-                        store_every=run.pop("store_every", 10), progress=not args.quiet, **run)
+                        store_every=run.pop("store_every", 10), progress=not args.quiet,
+                        resume=args.resume, **run)
     print(f"femehl: done in {res.info['wall_s']:.1f} s; wrote {out}/summary.csv, fields.pvd, centreline.png, fields.png")
+    if dim is not None:
+        print(f"femehl: wrote {_write_si_summary(dim, res, out)} (SI units)")
     for t in sorted({1.0, float(res.t[-1])}):
         if t <= res.t[-1] + 1e-9:
             print(f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
                   f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}")
     return 0
+
+
+def _write_si_summary(dim, result, out):
+    """``out/summary_si.csv``: the per-step table in SI units (scene stated with [si])."""
+    import csv
+    import pathlib
+
+    table = dim.result_table(result)
+    path = pathlib.Path(out) / "summary_si.csv"
+    cols = list(table)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([f"{c}_{dim.RESULT_COLUMNS[c][2]}" for c in cols])
+        for i in range(len(table["t"])):
+            w.writerow([f"{table[c][i]:.10g}" for c in cols])
+    return path
 
 
 def _bench(args):

@@ -44,3 +44,14 @@ class FilmRuptureError(SolverError):
 
 class SingularSystemError(SolverError):
     """The step's linear system is singular or its solution is not finite."""
+
+
+class RelaxationDivergedError(SolverError):
+    """The relaxation baseline (:mod:`femehl.baseline`) did not converge within a step.
+
+    ``iterations`` is how many fixed-point iterations were made before giving up.
+    """
+
+    def __init__(self, message: str, t: float, iterations: int):
+        super().__init__(message, t)
+        self.iterations = iterations

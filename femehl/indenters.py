@@ -33,7 +33,6 @@ z)``               interpolated bilinearly; must cover the disk ``r <= L``
 
 from __future__ import annotations
 
-import math
 import pathlib
 from dataclasses import dataclass, field
 from typing import Callable
@@ -78,7 +77,7 @@ class Sphere:
     si_units = {"R": "curvature"}
 
     def __post_init__(self):
-        _positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization.")
+        object.__setattr__(self, "R", _positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization."))
 
     def gap(self, x, y):
         """Rigid gap shape s(x, y) (>= 0, zero at the tip), broadcast over arrays."""
@@ -109,8 +108,8 @@ class Ellipsoid:
 
     def __post_init__(self):
         hint = "Give positive radii of curvature, e.g. Ellipsoid(Rx=0.5, Ry=2.0)."
-        _positive("Ellipsoid radius of curvature Rx", self.Rx, hint)
-        _positive("Ellipsoid radius of curvature Ry", self.Ry, hint)
+        object.__setattr__(self, "Rx", _positive("Ellipsoid radius of curvature Rx", self.Rx, hint))
+        object.__setattr__(self, "Ry", _positive("Ellipsoid radius of curvature Ry", self.Ry, hint))
 
     @property
     def axisymmetric(self) -> bool:
@@ -147,11 +146,11 @@ class FlatPunch:
     si_units = {"a": "length", "edge_radius": "curvature"}
 
     def __post_init__(self):
-        _positive("FlatPunch radius a", self.a, "Give the radius of the flat face; "
-                  "for a = 0 use Sphere(R=edge_radius).")
-        _positive("FlatPunch edge_radius", self.edge_radius,
+        object.__setattr__(self, "a", _positive("FlatPunch radius a", self.a, "Give the radius of the flat face; "
+                  "for a = 0 use Sphere(R=edge_radius)."))
+        object.__setattr__(self, "edge_radius", _positive("FlatPunch edge_radius", self.edge_radius,
                   "A sharp edge makes the pressure singular: use a rounded edge, "
-                  "edge_radius > 0 (e.g. 0.2).")
+                  "edge_radius > 0 (e.g. 0.2)."))
 
     def gap(self, x, y):
         """Rigid gap shape s(x, y) (>= 0, zero on the flat face), broadcast over arrays."""
@@ -310,6 +309,11 @@ class HeightMap:
         object.__setattr__(self, "z", z)
         object.__setattr__(self, "symmetric_y", bool(sym))
         object.__setattr__(self, "_interp", interp)
+
+    def __repr__(self):
+        return (f"HeightMap(x=[{self.x[0]:g} .. {self.x[-1]:g}] ({self.x.size}), "
+                f"y=[{self.y[0]:g} .. {self.y[-1]:g}] ({self.y.size}), "
+                f"z=[{self.z.min():g} .. {self.z.max():g}], symmetric_y={self.symmetric_y})")
 
     @classmethod
     def from_file(cls, path, symmetric_y: bool | None = None) -> "HeightMap":

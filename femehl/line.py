@@ -261,7 +261,9 @@ class LineStepper:
         dry contact half width (:meth:`LineScene.contact_halfwidth`), or ``L/2``.
     scheme : {"euler", "bdf2"}, default: "euler"
         "euler" is the paper's scheme (backward Euler, d^3 lagged one step);
-        "bdf2" is second order in time (:data:`femehl.stepping.SCHEMES`).
+        "bdf2" is second order in time (:data:`femehl.stepping.SCHEMES`) but
+        less robust: for k = 1, beta = 10, hc = -0.5 it kept oscillating at
+        dt = 0.2 (settled at dt <= 0.1), where "euler" settles up to dt = 0.5.
 
     Attributes
     ----------

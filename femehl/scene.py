@@ -27,12 +27,14 @@ Scenes are immutable; validation happens at construction and raises
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
 from .errors import SceneError
+from .indenters import Sphere  # indenters live in femehl.indenters; Sphere stays importable here
 
 __all__ = [
     "Sphere", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
@@ -44,12 +46,24 @@ __all__ = [
 # --------------------------------------------------------------------------
 # validation helpers
 # --------------------------------------------------------------------------
+def _short(value) -> str:
+    r = repr(value)
+    return r if len(r) <= 40 else r[:37] + "..."
+
+
 def check_finite(name: str, value, hint: str = "") -> float:
-    """Return ``value`` as a float, or raise SceneError if it is not a finite number."""
+    """Return ``value`` as a float, or raise SceneError if it is not a finite real number.
+
+    Strings, booleans, complex numbers and other non-real types are refused
+    (a "1" in a scene is a typo, not a number).
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise SceneError(f"{name} must be a real number, got {_short(value)} "
+                         f"({type(value).__name__}). {hint}".strip())
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a number, got {value!r}. {hint}".strip()) from None
+    except (TypeError, ValueError, OverflowError):
+        raise SceneError(f"{name} must be a finite number, got {_short(value)}. {hint}".strip()) from None
     if not math.isfinite(v):
         raise SceneError(f"{name} must be finite, got {v}. {hint}".strip())
     return v
@@ -102,11 +116,23 @@ class Table:
     values: tuple
 
     def __post_init__(self):
-        try:
-            t = np.asarray(self.times, dtype=float).ravel()
-            v = np.asarray(self.values, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise SceneError("Table times and values must be sequences of numbers.") from None
+        def numbers_of(seq, what):
+            if isinstance(seq, (str, bytes)):
+                raise SceneError(f"Table {what} must be a sequence of numbers, got {_short(seq)}.")
+            try:
+                items = np.asarray(seq, dtype=object).ravel().tolist()
+            except (TypeError, ValueError):
+                raise SceneError(f"Table {what} must be a sequence of numbers.") from None
+            bad = [x for x in items if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real)]
+            if bad:
+                raise SceneError(f"Table {what} must hold real numbers, got {_short(bad[0])}.")
+            try:
+                return np.array([float(x) for x in items], dtype=float)
+            except OverflowError:
+                raise SceneError(f"Table {what} hold a number too large for a float.") from None
+
+        t = numbers_of(self.times, "times")
+        v = numbers_of(self.values, "values")
         if t.size == 0:
             raise SceneError("Table is empty: give at least one (time, value) pair.")
         if t.size != v.size:
@@ -136,9 +162,9 @@ class RampHold:
     t1: float = 1.0
 
     def __post_init__(self):
-        check_finite("h0", self.h0)
-        check_finite("h_end", self.h_end)
-        check_positive("t1 (end of the ramp)", self.t1)
+        object.__setattr__(self, "h0", check_finite("h0", self.h0))
+        object.__setattr__(self, "h_end", check_finite("h_end", self.h_end))
+        object.__setattr__(self, "t1", check_positive("t1 (end of the ramp)", self.t1))
 
     def __call__(self, t: float) -> float:
         s = min(max(t / self.t1, 0.0), 1.0)
@@ -154,12 +180,17 @@ class TanhStart:
     V_ss: float = 1.0
 
     def __post_init__(self):
-        check_finite("t1 (start of sliding)", self.t1)
-        check_positive("T (sliding ramp time)", self.T)
-        check_finite("V_ss", self.V_ss)
+        object.__setattr__(self, "t1", check_finite("t1 (start of sliding)", self.t1))
+        object.__setattr__(self, "T", check_positive("T (sliding ramp time)", self.T))
+        object.__setattr__(self, "V_ss", check_finite("V_ss", self.V_ss))
 
     def __call__(self, t: float) -> float:
         return 0.0 if t < self.t1 else self.V_ss * math.tanh((t - self.t1) / self.T)
+
+
+#: The domain must reach CONTACT_MARGIN times the geometric overlap radius a_geo of the
+#: deepest indentation: 1.5/sqrt(2) ~ 1.06, i.e. L >= 1.5 a_Hertz for a sphere.
+CONTACT_MARGIN = 1.5 / math.sqrt(2.0)
 
 
 def _as_time_function(name: str, f) -> Callable[[float], float]:
@@ -168,12 +199,6 @@ def _as_time_function(name: str, f) -> Callable[[float], float]:
     if not callable(f):
         raise SceneError(f"{name} must be a number or a callable of time, got {type(f).__name__}.")
     return f
-
-
-# --------------------------------------------------------------------------
-# indenters: defined in femehl.indenters (Sphere stays importable from here)
-# --------------------------------------------------------------------------
-from .indenters import Sphere  # noqa: E402  (after the helpers it uses lazily)
 
 
 # --------------------------------------------------------------------------
@@ -188,6 +213,7 @@ class HalfSpace:
 
     def __post_init__(self):
         nu = check_finite("Poisson ratio nu", self.nu)
+        object.__setattr__(self, "nu", nu)
         if not (-1.0 < nu <= 0.5):
             raise SceneError(f"Poisson ratio nu must lie in (-1, 0.5], got {nu}.")
 
@@ -212,7 +238,7 @@ class Winkler:
     kind = "winkler"
 
     def __post_init__(self):
-        check_positive("Winkler stiffness k", self.k)
+        object.__setattr__(self, "k", check_positive("Winkler stiffness k", self.k))
 
 
 # --------------------------------------------------------------------------
@@ -225,8 +251,8 @@ class Fluid:
     beta: float = 200.0
 
     def __post_init__(self):
-        check_positive("beta", self.beta,
-                       "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it.")
+        object.__setattr__(self, "beta", check_positive("beta", self.beta,
+                       "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it."))
 
 
 @dataclass(frozen=True)
@@ -278,7 +304,7 @@ class Domain:
     L: float = 2.0
 
     def __post_init__(self):
-        check_positive("Domain radius L", self.L)
+        object.__setattr__(self, "L", check_positive("Domain radius L", self.L))
 
 
 @dataclass(frozen=True)
@@ -307,30 +333,165 @@ class Scene:
         self._check_domain_holds_contact()
 
     def _check_domain_holds_contact(self):
-        """The domain must reach well past the largest contact radius of the run."""
+        """The domain must reach well past the largest contact of the run, for any indenter.
+
+        The rigid gap ``hc_min + s(x, y)`` is sampled on a polar grid out to
+        ``1.5 L`` (linear along each ray between samples); ``a_geo`` is the
+        largest radius where it is < 0 (the geometric overlap).  The rule is
+        ``L >= CONTACT_MARGIN * a_geo`` with ``CONTACT_MARGIN = 1.5/sqrt(2)``:
+        for a sphere the Hertz radius is ``a_geo/sqrt(2)``, so this is
+        ``L >= 1.5 a_Hertz``.  ``hc_min`` is the deepest clearance of the gap
+        history over ``t`` in [0, 10] (and every table time); under imposed load
+        it is the depth ``delta`` at which the dry contact carries the largest
+        |F(t)|: on a half space the Hertz law of the equivalent sphere (same
+        ``a_geo`` at depth ``delta``), ``F = (4/(3 pi)) a_geo delta / (sqrt(2) c)``
+        with ``c = 2(1 - nu)`` (exactly ``F = (4/(3 pi)) a^3`` for the unit
+        sphere, nu = 0.5); on a Winkler foundation ``F = k int (delta - s)+ dA``;
+        a rigid substrate is never indented under load (no check).
+
+        Also checks that the indenter covers the domain (``check_domain(L)``
+        of a height map), that its gap is finite on the domain, and that the
+        initial film ``hc(0) + s`` is positive everywhere.
+        """
         L = self.domain.L
-        # deepest indentation over a generous horizon, for a sphere a ~ sqrt(2 R |hc|)
-        R = getattr(self.indenter, "R", None)
-        if R is None:
-            return
-        gap = self.motion.gap
+        ind = self.indenter
+        check = getattr(ind, "check_domain", None)
+        if callable(check):
+            check(L)
+        extent = float(getattr(ind, "extent", math.inf))
+        rmax = min(1.5 * L, max(extent, L))
+        nr, nth = 401, 96
+        r = np.linspace(0.0, rmax, nr)
+        half = bool(getattr(ind, "symmetric_y", False))
+        th = np.linspace(0.0, math.pi if half else 2.0 * math.pi, nth + 1 if half else nth,
+                         endpoint=half)
+        TH, RR = np.meshgrid(th, r, indexing="ij")                  # (nth, nr)
+        X, Y = RR * np.cos(TH), RR * np.sin(TH)
+        inside = RR <= L
+        try:
+            with np.errstate(all="ignore"):
+                s_in = np.asarray(ind.gap(X[inside], Y[inside]), dtype=float)
+        except SceneError:
+            raise
+        except Exception as exc:
+            raise SceneError(f"the indenter's gap(x, y) failed on the domain r <= {L:g} "
+                             f"({type(exc).__name__}: {exc}); fix the shape function.") from None
+        if s_in.shape != X[inside].shape or not np.all(np.isfinite(s_in)):
+            raise SceneError(f"the indenter's gap(x, y) must return one finite value per point "
+                             f"on the domain r <= {L:g}; fix the shape function.")
+        S = np.full(X.shape, np.inf)
+        S[inside] = s_in
+        if (~inside).any():
+            try:
+                with np.errstate(all="ignore"):
+                    s_out = np.asarray(ind.gap(X[~inside], Y[~inside]), dtype=float)
+                if s_out.shape == X[~inside].shape:
+                    # beyond the domain a non-finite gap counts as "no contact"
+                    S[~inside] = np.where(np.isfinite(s_out), s_out, np.inf)
+            except Exception:
+                pass
+        hc0 = self.motion.hc(0.0)
+        dmin = hc0 + float(s_in.min())
+        if dmin <= 0.0:
+            raise SceneError(
+                f"the initial film hc(0) + s(x, y) reaches {dmin:.3g} <= 0 on the domain: the "
+                f"indenter's gap has a minimum {float(s_in.min()):.3g} below its tip. Shift the "
+                "shape so that s >= 0 with s(0, 0) = 0, or start with a larger gap hc(0).")
+
+        def a_geo(depth):
+            """Largest radius where -depth + s < 0 (rays interpolated linearly)."""
+            g = S - depth                                            # < 0: overlap
+            neg = g < 0.0
+            if not neg.any():
+                return 0.0
+            rows = np.flatnonzero(neg.any(axis=1))
+            last = nr - 1 - np.argmax(neg[rows, ::-1], axis=1)       # last negative sample
+            if np.any(last == nr - 1):
+                return math.inf                                      # beyond the sampled disk
+            g0, g1 = g[rows, last], g[rows, last + 1]
+            with np.errstate(all="ignore"):
+                frac = np.where(np.isfinite(g1), g0 / (g0 - g1), 1.0)
+            return float(np.max(r[last] + frac * (r[last + 1] - r[last])))
+
+        times = self._check_times()
         if self.motion.load_controlled:
-            return
-        if isinstance(gap, RampHold):
-            hmin = min(gap.h0, gap.h_end)
-        elif isinstance(gap, Table):
-            hmin = min(gap.values)
-        elif isinstance(gap, Constant):
-            hmin = gap.value
+            Fs = []
+            for t in times:
+                try:
+                    Fs.append(abs(self.motion.F(t)))
+                except SceneError:
+                    continue                 # the run reports a non-finite load when it gets there
+            F = max(Fs, default=0.0)
+            kind = getattr(self.substrate, "kind", "halfspace")
+            if F == 0.0 or kind == "rigid":
+                return                       # a rigid substrate is never indented
+            if kind == "winkler":
+                k = float(self.substrate.k)
+                wr = np.gradient(r) * r                              # r dr (trapezoid-like)
+                wth = (math.pi if half else 2.0 * math.pi) / (th.size - (1 if half else 0))
+                wt = np.full(th.size, wth)
+                if half:
+                    wt[[0, -1]] *= 0.5
+                    wt *= 2.0                                        # mirror half
+
+                def F_est(depth):        # dry Winkler contact: F = k int (depth - s)+ dA
+                    return k * float(wt @ np.maximum(depth - S, 0.0) @ wr)
+            else:
+                c = float(getattr(self.substrate, "compliance", 1.0))
+
+                def F_est(depth):        # Hertz law of the equivalent sphere
+                    return (4.0 / (3.0 * math.pi)) * a_geo(depth) * depth / (math.sqrt(2.0) * c)
+
+            lo, hi = 0.0, 1.0
+            while F_est(hi) < F and math.isfinite(F_est(hi)) and hi < 1e6:
+                lo, hi = hi, 2.0 * hi
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                if F_est(mid) < F:
+                    lo = mid
+                else:
+                    hi = mid
+            depth = hi
+            a = a_geo(depth)
+            what = (f"the largest imposed load |F| = {F:g} (sampled over t in [0, {times[-1]:g}]) "
+                    f"presses the indenter about {depth:.3g} deep (dry-contact estimate)")
         else:
-            return
-        if hmin < 0.0:
-            a = math.sqrt(R * (-hmin))  # Hertz contact radius for indentation depth |hc|
-            if L < 1.5 * a:
-                raise SceneError(
-                    f"Domain radius L = {L:g} is too small to hold the contact: an indentation "
-                    f"hc = {hmin:g} makes a contact of radius about {a:.3g}, and the pressure "
-                    f"must decay before r = L. Use L >= {1.5 * a:.3g} (the paper uses L = 2a).")
+            hs = []
+            for t in times:
+                try:
+                    hs.append(self.motion.hc(t))
+                except SceneError:
+                    continue
+            hmin = min(hs, default=hc0)
+            if hmin >= 0.0:
+                return
+            a = a_geo(-hmin)
+            what = f"an indentation hc = {hmin:g}"
+        need = CONTACT_MARGIN * a
+        if L < need:
+            need_txt = f"{need:.3g}" if math.isfinite(need) else f"more than {CONTACT_MARGIN * rmax:.3g}"
+            a_txt = f"{a:.3g}" if math.isfinite(a) else f"more than {rmax:.3g}"
+            raise SceneError(
+                f"Domain radius L = {L:g} is too small to hold the contact: {what}, which "
+                f"overlaps the rigid shape out to r = {a_txt} (a contact of radius about "
+                f"{a / math.sqrt(2.0):.3g} for a sphere), and the pressure must decay before "
+                f"r = L. Use L >= {need_txt} (the paper uses L = 2a)"
+                + (", and extend the height map to cover it." if math.isfinite(extent) else "."))
+
+    def _check_times(self):
+        """Times at which the gap / load histories are sampled by the domain check."""
+        t_hi = 10.0
+        extra = []
+        for f in (self.motion.gap, self.motion.load):
+            for attr in ("times",):
+                extra.extend(getattr(f, attr, ()) or ())
+            for attr in ("t1",):
+                v = getattr(f, attr, None)
+                if isinstance(v, (int, float)):
+                    extra.append(float(v))
+        extra = [t for t in extra if math.isfinite(t) and t >= 0.0]
+        t_hi = max([t_hi] + extra)
+        return np.unique(np.concatenate([np.linspace(0.0, t_hi, 1001), extra]))
 
     # ---- what the scene calls for (design.md section 6) -------------------
     def has_sliding(self, t_end: float, n: int = 2001) -> bool:
@@ -386,7 +547,7 @@ class Dimensional:
 
     def __post_init__(self):
         for name in ("R", "G", "eta", "V_ss", "h_inf"):
-            check_positive(f"{name} [SI]", getattr(self, name))
+            object.__setattr__(self, name, check_positive(f"{name} [SI]", getattr(self, name)))
         HalfSpace(self.nu)
 
     @property
@@ -437,6 +598,39 @@ class Dimensional:
     def from_si(self, quantity: str, value):
         """Inverse of :meth:`to_si`."""
         return np.asarray(value) / self.to_si(quantity, 1.0)
+
+    #: columns of :meth:`result_table` -> (normalized Result column, scale, SI unit)
+    RESULT_COLUMNS = {
+        "t": ("t", "time", "s"),
+        "hc": ("hc", "height", "m"),
+        "load": ("load", "force", "N"),
+        "film_center": ("film_center", "height", "m"),
+        "film_min": ("film_min", "height", "m"),
+        "film_min_x": ("film_min_x", "length", "m"),
+        "film_min_y": ("film_min_y", "length", "m"),
+        "p_max": ("p_max", "pressure", "Pa"),
+        "p_max_x": ("p_max_x", "length", "m"),
+        "p_max_y": ("p_max_y", "length", "m"),
+    }
+
+    def result_table(self, result) -> dict:
+        """The per-step table of a normalized ``result`` in SI units.
+
+        Parameters
+        ----------
+        result : femehl.result.Result
+            A run of the scene of this experiment (normalized units).
+
+        Returns
+        -------
+        dict of numpy arrays
+            ``t`` [s], ``hc`` [m], ``load`` [N], ``film_center`` [m], ``film_min`` [m],
+            ``film_min_x``, ``film_min_y`` [m], ``p_max`` [Pa], ``p_max_x``,
+            ``p_max_y`` [m]; the units are in :attr:`RESULT_COLUMNS`.
+        """
+        s = result.summary()
+        return {name: np.asarray(self.to_si(scale, s[col]), dtype=float)
+                for name, (col, scale, _unit) in self.RESULT_COLUMNS.items()}
 
     def scene(self, h0: float, t1: float | None = None, T: float | None = None,
               L: float = 2.0) -> Scene:

@@ -4,30 +4,45 @@ Each table names a *kind* looked up in a registry, never an if/elif chain:
 add a shape, substrate or time function by adding it to the registry.
 A commented example is ``examples/paper_sphere.toml``; the format::
 
-    [indenter]            kind = "sphere", R = 1.0
+    [indenter]            kind = "sphere" (R) | "ellipsoid" (Rx, Ry)
+                          | "flat_punch" (a, edge_radius)
+                          | "heightmap" (file = "map.npz" | x, y, z [, symmetric_y])
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
     [fluid]               beta = 200.0
     [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)
                           | "table" (times = [...], values = [...])
     [motion.velocity]     kind = "tanh" (t1, T, V_ss) | "constant" | "table"
+    [motion.load]         optional imposed load F(t): a number or a time-function
+                          table as above; hc(t) is then solved for and
+                          [motion.gap] gives only hc(0)
     [domain]              L = 2.0
     [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions
 
-Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L])
-states the paper's experiment in SI units and replaces the tables above.
+A height map file is an ``.npz`` with arrays x, y, z (``np.savez``), its path
+relative to the scene file.  ``kind = "shape"`` (a Python function) exists
+only in Python.
+
+Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
+load]) states the paper's experiment in SI units and replaces the tables
+above, except ``[indenter]``, which may then give an analytic shape in metres
+(R of [si] is the normalizing radius of curvature; ``load`` [N] imposes a
+constant load instead of the gap ramp).  ``femehl run`` then also writes
+``summary_si.csv``.  See ``examples/sphere_si.toml``.
 Every problem raises :class:`~femehl.errors.SceneFileError` naming the file
 and the key to fix.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 import pathlib
 
 from .errors import SceneError, SceneFileError
+from .indenters import INDENTERS, si_indenter
 from .scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
-                    Scene, Sphere, Table, TanhStart, Winkler)
+                    Scene, Table, TanhStart, Winkler)
 
 try:
     import tomllib
@@ -36,7 +51,6 @@ except ModuleNotFoundError:  # Python < 3.11
 
 __all__ = ["load_scene_file", "INDENTERS", "SUBSTRATES", "TIME_FUNCTIONS", "RUN_KEYS"]
 
-INDENTERS = {"sphere": Sphere}
 SUBSTRATES = {"halfspace": HalfSpace, "winkler": Winkler, "rigid": Rigid}
 TIME_FUNCTIONS = {"constant": Constant, "table": Table, "ramp_hold": RampHold, "tanh": TanhStart}
 RUN_KEYS = {"method", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions",
@@ -52,6 +66,20 @@ def _build(registry, table, where, path):
         raise SceneFileError(f"{path}: [{where}] kind = {kind!r} is not known; "
                              f"use one of {sorted(registry)}.")
     cls = registry[kind]
+    if "file" in table and hasattr(cls, "from_file"):
+        # data read from a file next to the scene file (e.g. a height map .npz)
+        file = pathlib.Path(str(table.pop("file")))
+        if not file.is_absolute():
+            file = pathlib.Path(path).parent / file
+        allowed = set(inspect.signature(cls.from_file).parameters) - {"path"}
+        extra = set(table) - allowed
+        if extra:
+            raise SceneFileError(f"{path}: [{where}] kind = {kind!r} with file = ... does not take "
+                                 f"{sorted(extra)}; it takes {sorted(allowed | {'file'})}.")
+        try:
+            return cls.from_file(file, **table)
+        except (SceneError, TypeError) as exc:
+            raise SceneFileError(f"{path}: [{where}]: {exc}") from None
     allowed = set(inspect.signature(cls).parameters)
     extra = set(table) - allowed
     if extra:
@@ -67,12 +95,20 @@ def _build(registry, table, where, path):
 
 def _time_function(value, where, path):
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return Constant(value)
+        try:
+            return Constant(value)
+        except SceneError as exc:
+            raise SceneFileError(f"{path}: [{where}]: {exc}") from None
     return _build(TIME_FUNCTIONS, value, where, path)
 
 
 def load_scene_file(path) -> tuple[Scene, dict]:
     """Read a TOML scene file; return ``(scene, run_options)``.
+
+    When the file states the scene in SI units (an ``[si]`` table), the run
+    options also hold the :class:`~femehl.scene.Dimensional` under the key
+    ``"_dimensional"`` (pop it before passing the options to a solver; the CLI
+    uses it to write ``summary_si.csv``).
 
     Parameters
     ----------
@@ -102,7 +138,8 @@ def load_scene_file(path) -> tuple[Scene, dict]:
         raise SceneFileError(f"{path}: [run] does not take {sorted(extra)}; it takes {sorted(RUN_KEYS)}.")
     try:
         if "si" in raw:
-            scene = _si_scene(raw, path)
+            scene, dim = _si_scene(raw, path)
+            run["_dimensional"] = dim
         else:
             scene = _normalized_scene(raw, path)
     except SceneFileError:
@@ -113,18 +150,45 @@ def load_scene_file(path) -> tuple[Scene, dict]:
 
 
 def _si_scene(raw, path):
-    clash = {"indenter", "substrate", "fluid", "motion", "domain"} & set(raw)
+    """The paper's experiment in SI units; returns (scene, Dimensional)."""
+    clash = {"substrate", "fluid", "motion", "domain"} & set(raw)
     if clash:
-        raise SceneFileError(f"{path}: [si] replaces {sorted(clash)}; give one or the other.")
-    si = dict(raw["si"])
-    keys = {"R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L"}
+        raise SceneFileError(f"{path}: [si] replaces {sorted(clash)}; give one or the other "
+                             "(only [indenter] may accompany [si], in metres).")
+    si = raw["si"]
+    if not isinstance(si, dict):
+        raise SceneFileError(f"{path}: [si] must be a table.")
+    si = dict(si)
+    keys = {"R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L", "load"}
+    optional = {"nu", "t1", "T", "L", "load"}
     extra = set(si) - keys
-    missing = {"R", "G", "eta", "V_ss", "h_inf", "h0"} - set(si)
+    missing = (keys - optional) - set(si)
     if extra or missing:
-        raise SceneFileError(f"{path}: [si] needs {sorted(keys - {'nu', 't1', 'T', 'L'})} "
-                             f"(optional nu, t1, T, L); missing {sorted(missing)}, unknown {sorted(extra)}.")
-    dim = Dimensional(**{k: si[k] for k in ("R", "G", "eta", "V_ss", "h_inf")}, nu=si.get("nu", 0.5))
-    return dim.scene(si["h0"], si.get("t1"), si.get("T"), si.get("L", 2.0))
+        raise SceneFileError(f"{path}: [si] needs {sorted(keys - optional)} "
+                             f"(optional {sorted(optional)}); missing {sorted(missing)}, unknown {sorted(extra)}.")
+    try:
+        dim = Dimensional(**{k: si[k] for k in ("R", "G", "eta", "V_ss", "h_inf")}, nu=si.get("nu", 0.5))
+        scene = dim.scene(si["h0"], si.get("t1"), si.get("T"), si.get("L", 2.0))
+        changes = {}
+        if "indenter" in raw:
+            ind = raw["indenter"]
+            if not isinstance(ind, dict):
+                raise SceneFileError(f"{path}: [indenter] must be a table.")
+            ind = dict(ind)
+            kind = ind.pop("kind", None)
+            changes["indenter"] = si_indenter(kind, ind, dim)
+        if "load" in si:
+            from .scene import check_finite
+            F = check_finite("[si] load [N]", si["load"]) / dim.force
+            changes["motion"] = Motion(gap=Constant(scene.motion.hc(0.0)),
+                                       velocity=scene.motion.velocity, load=Constant(F))
+        if changes:
+            scene = dataclasses.replace(scene, **changes)
+    except SceneFileError:
+        raise
+    except SceneError as exc:
+        raise SceneFileError(f"{path}: [si]: {exc}") from None
+    return scene, dim
 
 
 def _normalized_scene(raw, path):
@@ -133,17 +197,23 @@ def _normalized_scene(raw, path):
     fluid = raw.get("fluid", {})
     if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
         raise SceneFileError(f"{path}: [fluid] takes only beta.")
-    motion = dict(raw.get("motion", {}))
-    extra = set(motion) - {"gap", "velocity"}
+    motion = raw.get("motion", {})
+    if not isinstance(motion, dict):
+        raise SceneFileError(f"{path}: [motion] must be a table.")
+    motion = dict(motion)
+    extra = set(motion) - {"gap", "velocity", "load"}
     if extra:
-        raise SceneFileError(f"{path}: [motion] takes gap and velocity, not {sorted(extra)}.")
+        raise SceneFileError(f"{path}: [motion] takes gap, velocity and load, not {sorted(extra)}.")
     gap = _time_function(motion.get("gap", {"kind": "ramp_hold"}), "motion.gap", path)
     vel = _time_function(motion.get("velocity", 0.0), "motion.velocity", path)
+    load = None
+    if "load" in motion:
+        load = _time_function(motion["load"], "motion.load", path)
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
     return Scene(indenter=indenter, substrate=substrate, fluid=Fluid(**fluid),
-                 motion=Motion(gap=gap, velocity=vel), domain=Domain(**domain))
+                 motion=Motion(gap=gap, velocity=vel, load=load), domain=Domain(**domain))
 
 
 def run_options(run: dict) -> dict:

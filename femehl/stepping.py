@@ -64,7 +64,10 @@ def check_run(t_end, dt):
     dt = check_positive("dt", dt, "Give a positive time step (the paper uses 0.01).")
     if dt > t_end:
         raise SceneError(f"dt = {dt:g} is larger than t_end = {t_end:g}: use dt <= t_end.")
-    n = int(math.ceil(t_end / dt - 1e-9))
+    ratio = t_end / dt
+    if not math.isfinite(ratio) or ratio > 10_000_000:
+        raise SceneError(f"t_end/dt = {ratio:.3g} steps is too many: increase dt or decrease t_end.")
+    n = int(math.ceil(ratio - 1e-9))
     if n > 10_000_000:
         raise SceneError(f"{n} steps is too many: increase dt or decrease t_end.")
     return t_end, dt, n
@@ -96,7 +99,7 @@ SCHEMES = {"euler": Scheme("euler", 1), "bdf2": Scheme("bdf2", 2)}
 
 
 def get_scheme(name: str) -> Scheme:
-    if name not in SCHEMES:
+    if not isinstance(name, str) or name not in SCHEMES:
         raise SceneError(f"unknown time scheme {name!r}: choose one of {sorted(SCHEMES)}.")
     return SCHEMES[name]
 

@@ -50,7 +50,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import SingularSystemError
+from ..errors import SceneError, SingularSystemError
 from ..kernels import quad_influence
 from ..scene import HalfSpace, Rigid, Scene, Winkler
 from ..stepping import State
@@ -136,6 +136,11 @@ class FDStepper:
     method = "fd"
 
     def __init__(self, scene: Scene, dr: float = 0.05, dtheta: float = math.pi / 24):
+        if not getattr(scene.indenter, "symmetric_y", False):
+            raise SceneError(
+                "the FD solver computes the half plane y >= 0 and mirrors it (paper Eq. 17b), so "
+                f"it needs an indenter symmetric in y; {type(scene.indenter).__name__} is not. "
+                "Use method='fe' (it meshes the full disk for such shapes).")
         self.scene = scene
         self.grid = grid = PolarGrid(scene.domain.L, dr, dtheta)
         self.disc = grid
@@ -218,25 +223,61 @@ class FDStepper:
         return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.E.shape[1]))
 
     def step(self, state: State, t_new: float, dt: float) -> State:
+        """One lagged step: ONE linear system (bordered by one row under imposed load).
+
+        Under imposed load F(t) the clearance hc^{k+1} is one more unknown with
+        the row ``load(p) = F(t^{k+1})``: since the right-hand side is affine in
+        hc, ``p = x1 + hc x2`` with ``A x1 = rhs(h = shape)`` and
+        ``A x2 = d rhs / d hc = S 1 / dt`` (``G 1 = 0``), both from one LU.
+        """
         mo = self.scene.motion
-        hc, V = mo.hc(t_new), mo.V(t_new)
-        h = hc + self.shape
+        V = mo.V(t_new)
         L = self.reynolds_matrix(state.d)
-        rhs = -V * (self.G @ h) + self.S @ (h - state.d) / dt
         if self.dense:
             A = self.beta * L.toarray()
             A += V * self.GW
             A -= self.SW / dt
             try:
-                p = sla.solve(A, rhs, check_finite=True)
+                lu = sla.lu_factor(A, check_finite=True)
             except (np.linalg.LinAlgError, ValueError) as exc:
                 raise SingularSystemError(
                     f"FD step at t = {t_new:.6g}: the linear system is singular ({exc}). "
                     "Try a smaller dt or a finer grid.", t=t_new) from None
+            if np.any(np.diag(lu[0]) == 0.0):
+                raise SingularSystemError(
+                    f"FD step at t = {t_new:.6g}: the linear system is singular (zero pivot). "
+                    "Try a smaller dt or a finer grid.", t=t_new)
+
+            def solve(b):
+                return sla.lu_solve(lu, b)
         else:
             A = (self.beta * L + V * self.GW - self.SW / dt).tocsc()
-            p = spla.spsolve(A, rhs)
-        if not np.all(np.isfinite(p)):
+            try:
+                lu = spla.splu(A)
+            except RuntimeError as exc:
+                raise SingularSystemError(
+                    f"FD step at t = {t_new:.6g}: the sparse system is singular ({exc}). "
+                    "Try a smaller dt or a finer grid.", t=t_new) from None
+            solve = lu.solve
+
+        def rhs_for(h):
+            return -V * (self.G @ h) + self.S @ (h - state.d) / dt
+
+        if mo.load_controlled:
+            F = mo.F(t_new)
+            x1 = solve(rhs_for(self.shape))
+            x2 = solve(self.S @ np.full(self.shape.size, 1.0 / dt))
+            g = 2.0 * (self.E.T @ self.area)              # load = g . p_free (whole plane)
+            den = float(g @ x2)
+            if not np.isfinite(den) or den == 0.0:
+                raise SingularSystemError(f"FD step at t = {t_new:.6g}: the load row is singular "
+                                          "(the film does not respond to hc).", t=t_new)
+            hc = (F - float(g @ x1)) / den
+            p = x1 + hc * x2
+        else:
+            hc = mo.hc(t_new)
+            p = solve(rhs_for(hc + self.shape))
+        if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"FD step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
                 "or ill-conditioned. Try a smaller dt or a finer grid.", t=t_new)

@@ -15,12 +15,25 @@ eliminated the system in the free pressure unknowns is
 and only K changes from step to step: Bx C and M C depend on the mesh alone
 and are formed once.  ``d^{k+1} = h^{k+1} + C p^{k+1}`` on elements.
 
-Linear algebra (the step must still solve A p = b to a stated tolerance):
-a dense LU of a recent A is kept and used as the preconditioner of GMRES;
-the LU is refreshed when GMRES needs more than ``refactor_after``
-iterations, or when the step size changes.  ``rtol`` is the relative
-residual the step is solved to (default 1e-10).  ``linear_solver="lu"``
-refactorizes at every step instead (the paper's direct solve).
+Linear algebra (the step must still solve A p = b to a stated tolerance;
+``rtol`` is the relative residual ||b - A p|| / ||b||, default 1e-10):
+``A z = beta K z + (V Bx + c M)(C z)`` needs ONE dense product (C z) and
+sparse work, and any vector z whose C z is known can be re-applied with a
+new K and V for sparse work only.  Each step therefore minimizes the
+residual (GCR, equivalent to flexible GMRES) first over *recycled*
+directions -- the last solutions and the last steps' search directions,
+kept with their C z -- and then over new directions z = LU^{-1} r, with the
+LU of a recent A as the preconditioner (one triangular-solve pair + one
+dense C product each).  The true residual b - A p is checked (sparse work,
+from the tracked C p) before a step is accepted; otherwise the step is
+solved directly.  The LU is refreshed by cost balancing: when the
+preconditioned iterations of the last solve cost more than the average
+cost per solve since the last factorization (factorization included), or
+when a0/dt changed by more than 10 %.  ``refactor_after=n`` instead
+refreshes when a solve needed more than n preconditioned iterations.
+``linear_solver="lu"`` refactorizes at every step (the paper's direct
+solve).  The dense A is formed in place (no dense temporaries) and its
+transpose, which is Fortran-ordered, is LU-factorized in place.
 """
 
 from __future__ import annotations
@@ -174,8 +187,12 @@ def compliance_operator(substrate, disc, free):
 
 @dataclass
 class _Factor:
-    lu: tuple
+    lu: tuple           # LAPACK LU of A^T (A C-ordered = A^T Fortran-ordered: no copy)
     key: float          # a0/dt of the factorized matrix
+    cost: float         # wall time of forming and factorizing A (s)
+    total: float = 0.0  # cost of this factor's cycle: factorization + preconditioned iterations
+    solves: int = 0     # solves of this cycle (the factorizing one included)
+    stale: bool = False # refresh at the next solve
 
 
 class FEStepper:
@@ -192,23 +209,31 @@ class FEStepper:
         "euler" is the paper's first-order scheme; "bdf2" is second order and
         still one linear system per step (see :data:`femehl.stepping.SCHEMES`).
     linear_solver : {"gmres", "lu"}, default: "gmres"
-        "gmres": GMRES preconditioned by the LU of a recent step; "lu": a new
+        "gmres": minimal residual (flexible GMRES / GCR) over recycled directions
+        and directions preconditioned by the LU of a recent step; "lu": a new
         dense LU at every step.
     rtol : float, default: 1e-10
         Relative residual ||b - A p|| / ||b|| every step is solved to.
-    refactor_after : int, default: 8
-        Refresh the LU when GMRES needed more than this many iterations.
+    refactor_after : int, optional
+        Refresh the LU when a solve needed more than this many preconditioned
+        iterations; default (None): refresh by cost balancing (see module doc).
+    recycle : int, default: 8
+        Number of recycled directions kept between solves (0: none).
     """
 
     method = "fe"
 
     def __init__(self, scene: Scene, mesh="medium", half: bool | None = None,
                  scheme: str = "euler", linear_solver: str = "gmres", rtol: float = 1e-10,
-                 refactor_after: int = 8):
+                 refactor_after: int | None = None, recycle: int = 8):
         t0 = time.perf_counter()
         self.scene = scene
         self.scheme = get_scheme(scheme)
         symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
+        if half is not None and not isinstance(half, (bool, np.bool_)):
+            raise SceneError(f"half must be True, False or None (automatic), got {half!r}.")
+        if not isinstance(linear_solver, str):
+            raise SceneError(f"linear_solver must be 'gmres' or 'lu', got {linear_solver!r}.")
         if half is None:
             half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
         if half and not symmetric:
@@ -228,7 +253,17 @@ class FEStepper:
             raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
         self.linear_solver = linear_solver
         self.rtol = rtol
-        self.refactor_after = int(refactor_after)
+        if refactor_after is not None and (isinstance(refactor_after, bool)
+                                           or not isinstance(refactor_after, int) or refactor_after < 1):
+            raise SceneError(f"refactor_after must be an integer >= 1 or None, got {refactor_after!r}.")
+        if isinstance(recycle, bool) or not isinstance(recycle, int) or recycle < 0:
+            raise SceneError(f"recycle must be an integer >= 0, got {recycle!r}.")
+        self.refactor_after = refactor_after
+        self.recycle = recycle
+        self._solutions: list = []     # recent (x, C x) of the Krylov path
+        self._directions: list = []    # recent preconditioned (z, C z)
+        self.max_krylov = 30           # preconditioned iterations before a direct solve
+        self.precond_dtype = np.float32  # the LU is a preconditioner only: single precision
         self.disc = disc = FEDisc(dm)
         free = disc.free
         self.free = free
@@ -290,60 +325,95 @@ class FEStepper:
         K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
         return K[self.free][:, self.free]
 
-    def _matrix(self, K, V, c):
-        """A = beta K + V Bx C + c M C, with c = a0/dt."""
+    def _matrix(self, K, V, c, dtype=np.float64):
+        """A = beta K + V Bx C + c M C, with c = a0/dt.
+
+        Dense: formed in place in ``dtype`` (row blocks, no dense temporary), C-ordered.
+        """
         if self.dense:
-            A = self.beta * K.toarray()
-            if V != 0.0:
-                A += V * self.couette()[1]
-            A += c * self.MC
+            n = self.MC.shape[0]
+            A = np.empty((n, n), dtype=dtype)
+            BxC = self.couette()[1] if V != 0.0 else None
+            blk = max(1, (1 << 21) // max(n, 1))
+            for s in range(0, n, blk):
+                e = min(s + blk, n)
+                rows = c * self.MC[s:e]
+                if BxC is not None:
+                    rows += V * BxC[s:e]
+                A[s:e] = rows
+            Kc = K.tocoo()
+            np.add.at(A, (Kc.row, Kc.col), (self.beta * Kc.data).astype(dtype))
             return A
         A = self.beta * K + c * self.MC
         if V != 0.0:
             A = A + V * self.couette()[1]
         return A.tocsc()
 
+    def _coupling(self, V, c):
+        """G = V Bx + c M (sparse, free nodes x elements): A z = beta K z + G (C z)."""
+        G = self.M * c
+        if V != 0.0:
+            G = G + self.couette()[0] * V
+        return G.tocsr()
+
     def _solve(self, K, V, c, rhs, t_new):
         bnorm = float(np.linalg.norm(rhs))
         if bnorm == 0.0:
             return np.zeros_like(rhs), 0
         if not self.dense:
-            return spla.spsolve(self._matrix(K, V, c), rhs), 0
+            try:
+                return spla.splu(self._matrix(K, V, c)).solve(rhs), 0
+            except RuntimeError as exc:
+                raise SingularSystemError(
+                    f"FE step at t = {t_new:.6g}: the sparse system is singular ({exc}). "
+                    "Try a smaller dt or a finer mesh.", t=t_new) from None
         if self.linear_solver == "lu":
-            self._factor = None
-        f = self._factor
-        if f is None or abs(f.key - c) > 1e-9 * c:
             return self._direct(K, V, c, rhs, t_new), 0
-        BxC = self.couette()[1] if V != 0.0 else None
+        f = self._factor
+        fresh = f is None or f.stale or abs(f.key - c) > 0.1 * c
+        if fresh:
+            f = self._refactor(K, V, c, t_new)
+        t0 = time.perf_counter()
+        x, Cx, its, dirs = self._krylov(K, self._coupling(V, c), rhs, bnorm, f)
+        dt_solve = time.perf_counter() - t0
+        self.info["krylov_iterations"] += its
+        self.info["krylov_s"] = self.info.get("krylov_s", 0.0) + dt_solve
+        if x is None:
+            if fresh:        # even a fresh preconditioner failed: solve directly in double
+                return self._direct(K, V, c, rhs, t_new), its
+            f.stale = True
+            return self._solve(K, V, c, rhs, t_new)[0], its
+        self._remember(x, Cx, dirs)
+        self._last_Cx = (x, Cx)
+        # Refresh policy.  Cost balancing: a cycle costs the factorization plus the
+        # preconditioned iterations of its solves; refresh when the last solve's iterations
+        # cost more than the cycle's average per solve (the average then stops falling).
+        if self.refactor_after is not None:
+            f.stale = its > self.refactor_after
+        else:
+            marginal = its * self._t_iter
+            f.total += marginal
+            f.solves += 1
+            f.stale = marginal > f.total / f.solves
+        return x, its
 
-        def matvec(x):
-            y = self.beta * (K @ x) + self.MC @ (c * x)
-            if BxC is not None:
-                y += BxC @ (V * x)
-            return y
+    def _refactor(self, K, V, c, t_new):
+        """LU of the current A as the Krylov preconditioner (``precond_dtype``, in place)."""
+        self._factor = None                  # free the old factor before forming the new A
+        t0 = time.perf_counter()
+        A = self._matrix(K, V, c, dtype=self.precond_dtype)
+        lu = self._lu(A, t_new)
+        cost = time.perf_counter() - t0
+        self.info["factorizations"] += 1
+        self.info["factor_s"] = self.info.get("factor_s", 0.0) + cost
+        self._factor = _Factor(lu, c, cost, total=cost, solves=0)
+        return self._factor
 
-        n = rhs.size
-        A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
-        Minv = spla.LinearOperator((n, n), matvec=lambda x: sla.lu_solve(f.lu, x), dtype=float)
-        its = [0]
-
-        def count(_):
-            its[0] += 1
-
-        x, flag = spla.gmres(A, rhs, x0=sla.lu_solve(f.lu, rhs), rtol=self.rtol, atol=0.0, M=Minv,
-                             restart=30, maxiter=3, callback=count, callback_type="pr_norm")
-        res = np.linalg.norm(rhs - matvec(x)) / bnorm
-        self.info["krylov_iterations"] += its[0]
-        if flag != 0 or not np.isfinite(res) or res > 10 * self.rtol:
-            return self._direct(K, V, c, rhs, t_new), its[0]
-        if its[0] > self.refactor_after:
-            self._factor = None          # refresh at the next step
-        return x, its[0]
-
-    def _direct(self, K, V, c, rhs, t_new):
-        A = self._matrix(K, V, c)
+    @staticmethod
+    def _lu(A, t_new):
         try:
-            lu = sla.lu_factor(A, overwrite_a=True, check_finite=True)
+            # A is C-ordered, so A.T is Fortran-ordered: LAPACK factors it in place (LU of A^T)
+            lu = sla.lu_factor(A.T, overwrite_a=True, check_finite=True)
         except (ValueError, np.linalg.LinAlgError) as exc:
             raise SingularSystemError(f"FE step at t = {t_new:.6g}: cannot factor the system "
                                       f"({exc}). Try a smaller dt or a finer mesh.", t=t_new) from None
@@ -351,9 +421,112 @@ class FEStepper:
             raise SingularSystemError(
                 f"FE step at t = {t_new:.6g}: the linear system is singular (zero pivot). "
                 "Try a smaller dt or a finer mesh.", t=t_new)
-        self._factor = _Factor(lu, c)
+        return lu
+
+    def _direct(self, K, V, c, rhs, t_new):
+        """The paper's direct solve: a new dense LU (double) of A."""
+        t0 = time.perf_counter()
+        lu = self._lu(self._matrix(K, V, c), t_new)
         self.info["factorizations"] += 1
-        return sla.lu_solve(lu, rhs)
+        self.info["factor_s"] = self.info.get("factor_s", 0.0) + time.perf_counter() - t0
+        return sla.lu_solve(lu, rhs, trans=1)
+
+    def _precondition(self, f, r):
+        lu = f.lu[0]
+        return sla.lu_solve(f.lu, r.astype(lu.dtype, copy=False), trans=1,
+                            check_finite=False).astype(np.float64, copy=False)
+
+    def _krylov(self, K, G, b, bnorm, f):
+        """Minimal residual (GCR) over recycled + LU-preconditioned directions.
+
+        Every stored direction z carries its exact C z (one dense product when it was made),
+        so re-applying it with the new K and V is sparse work.  The result's C x is formed
+        with one dense product and the TRUE residual b - beta K x - G (C x) is checked.
+        Returns ``(x, C x, preconditioned iterations, new directions)``, or ``x = None``
+        when ``rtol`` was not reached in ``max_krylov`` iterations.
+        """
+        beta, C = self.beta, self.C
+        tol = self.rtol * bnorm
+        rec = self._solutions + self._directions
+        m = len(rec) + self.max_krylov
+        n, ne = b.size, C.shape[0]
+        Z = np.empty((m, n))            # row j: direction z_j
+        CZ = np.empty((m, ne))          # row j: C z_j
+        Q = np.empty((m, n))            # row j: orthonormal basis of A span(Z)
+        R = np.zeros((m, m))
+        g = np.zeros(m)
+        k = 0
+        r = b.copy()
+        if rec:
+            Zr = np.array([z for z, _ in rec])
+            CZr = np.array([cz for _, cz in rec])
+            AZ = beta * (K @ Zr.T) + G @ CZr.T                   # sparse work only
+            scale = np.linalg.norm(AZ, axis=0)
+            scale[scale == 0.0] = 1.0
+            q, rr, piv = sla.qr(AZ / scale, mode="economic", pivoting=True)
+            d = np.abs(np.diag(rr))
+            k = int(np.count_nonzero(d > 1e-8 * d[0])) if d.size and d[0] > 0 else 0
+            sel = piv[:k]
+            Z[:k] = Zr[sel] / scale[sel, None]
+            CZ[:k] = CZr[sel] / scale[sel, None]
+            Q[:k] = q[:, :k].T
+            R[:k, :k] = rr[:k, :k]
+            for _ in range(2):                      # r = b - Q Q^T b, reorthogonalized
+                h = Q[:k] @ r
+                r -= h @ Q[:k]
+                g[:k] += h
+        its = 0
+        k_rec = k
+        hist = [float(np.linalg.norm(r)) / bnorm]
+        while True:
+            if hist[-1] <= 0.5 * self.rtol or its >= self.max_krylov:
+                if k == 0:
+                    return None, None, its, []
+                y = sla.solve_triangular(R[:k, :k], g[:k])
+                x = y @ Z[:k]
+                Cx = C @ x                                      # exact, for the state and the check
+                rt = b - beta * (K @ x) - G @ Cx                # the TRUE residual
+                res = float(np.linalg.norm(rt))
+                hist.append(res / bnorm)
+                self._last_history = hist
+                if np.isfinite(res) and res <= tol:
+                    return x, Cx, its, [(Z[j].copy(), CZ[j].copy()) for j in range(k_rec, k)]
+                if its >= self.max_krylov or not np.isfinite(res):
+                    return None, None, its, []
+                r = rt - (Q[:k] @ rt) @ Q[:k]          # continue from the true residual
+            t0 = time.perf_counter()
+            z = self._precondition(f, r)
+            cz = C @ z                                          # the one dense product
+            q = beta * (K @ z) + G @ cz
+            h = np.zeros(k)
+            for _ in range(2):
+                hh = Q[:k] @ q
+                q -= hh @ Q[:k]
+                h += hh
+            nq = float(np.linalg.norm(q))
+            its += 1
+            if not np.isfinite(nq) or nq == 0.0:
+                return None, None, its, []
+            Q[k] = q / nq
+            R[:k, k] = h
+            R[k, k] = nq
+            Z[k] = z
+            CZ[k] = cz
+            g[k] = Q[k] @ r
+            r -= g[k] * Q[k]
+            k += 1
+            hist.append(float(np.linalg.norm(r)) / bnorm)
+            self._t_iter = time.perf_counter() - t0
+
+    _t_iter = 0.0
+
+    def _remember(self, x, Cx, dirs):
+        """Keep the newest solutions and preconditioned directions (with C z) for recycling."""
+        if self.recycle <= 0:
+            return
+        nsol = min(4, self.recycle)
+        self._solutions = ([(x, Cx)] + self._solutions)[:nsol]
+        self._directions = (dirs + self._directions)[:max(0, self.recycle - len(self._solutions))]
 
     # ---- stepping -----------------------------------------------------------
     def _state(self, step, t, hc, V, p_free, d_prev=None, dt_prev=None, info=None):

@@ -216,7 +216,7 @@ def test_singular_system_is_reported():
     """beta below the smallest normal float: the Poiseuille term underflows to zero."""
     sc = Scene(substrate=Rigid(), fluid=Fluid(5e-324), motion=Motion(gap=RampHold(1.0, 0.5, 1.0)))
     st = femehl.make_stepper(sc, "fe", mesh="coarse")
-    with pytest.warns(Warning), pytest.raises(SingularSystemError) as info:
+    with pytest.raises(SingularSystemError) as info:
         list(march(st, 0.2, 0.1))
     assert info.value.t == pytest.approx(0.1)
     assert "singular" in str(info.value) and "smaller dt" in str(info.value)

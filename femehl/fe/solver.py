@@ -357,6 +357,7 @@ class FEStepper:
         return G.tocsr()
 
     def _solve(self, K, V, c, rhs, t_new):
+        self._last_Cx = None
         bnorm = float(np.linalg.norm(rhs))
         if bnorm == 0.0:
             return np.zeros_like(rhs), 0
@@ -529,11 +530,12 @@ class FEStepper:
         self._directions = (dirs + self._directions)[:max(0, self.recycle - len(self._solutions))]
 
     # ---- stepping -----------------------------------------------------------
-    def _state(self, step, t, hc, V, p_free, d_prev=None, dt_prev=None, info=None):
+    def _state(self, step, t, hc, V, p_free, d_prev=None, dt_prev=None, info=None, Cp=None):
         disc = self.disc
         p = np.zeros(disc.nnodes)
         p[self.free] = p_free
-        Cp = np.asarray(self.C @ p_free).ravel()
+        if Cp is None:                      # the Krylov path hands over its exact C p
+            Cp = np.asarray(self.C @ p_free).ravel()
         w = -Cp
         d = hc + self.shape + Cp
         load = self.mult * float(self.node_weight @ p)
@@ -576,10 +578,12 @@ class FEStepper:
             # A p + col hc = rhs(s);  g . p = F   ->  p = x1 - hc x2
             F = mo.F(t_new)
             x1, its1 = self._solve(K, V, c, rhs_for(self.shape), t_new)
+            cx1 = self._known_Cx(x1)
             col = c * (self.M @ np.ones(self.disc.nelements))
             if Bx is not None:
                 col += V * (Bx @ np.ones(self.disc.nelements))
             x2, its2 = self._solve(K, V, c, col, t_new)
+            cx2 = self._known_Cx(x2)
             g = self.mult * self.node_weight[self.free]
             den = float(g @ x2)
             if not np.isfinite(den) or den == 0.0:
@@ -587,16 +591,23 @@ class FEStepper:
                                           "(the film does not respond to hc).", t=t_new)
             hc = (float(g @ x1) - F) / den
             p = x1 - hc * x2
+            Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
             its = its1 + its2
         else:
             hc = mo.hc(t_new)
             p, its = self._solve(K, V, c, rhs_for(hc + self.shape), t_new)
+            Cp = self._known_Cx(p)
         if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"FE step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
                 "or ill-conditioned. Try a smaller dt or a finer mesh.", t=t_new)
         return self._state(state.step + 1, t_new, hc, V, p, d_prev=state.d, dt_prev=dt,
-                           info={"krylov_iterations": its})
+                           info={"krylov_iterations": its}, Cp=Cp)
+
+    def _known_Cx(self, x):
+        """C x if the last solve that returned ``x`` already formed it, else None."""
+        last = getattr(self, "_last_Cx", None)
+        return last[1] if last is not None and last[0] is x else None
 
 
 def _nbytes(a) -> int:

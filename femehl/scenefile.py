@@ -53,7 +53,7 @@ __all__ = ["load_scene_file", "INDENTERS", "SUBSTRATES", "TIME_FUNCTIONS", "RUN_
 
 SUBSTRATES = {"halfspace": HalfSpace, "winkler": Winkler, "rigid": Rigid}
 TIME_FUNCTIONS = {"constant": Constant, "table": Table, "ramp_hold": RampHold, "tanh": TanhStart}
-RUN_KEYS = {"method", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions",
+RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions",
             "linear_solver"}
 
 

@@ -7,6 +7,7 @@ A commented example is ``examples/paper_sphere.toml``; the format::
     [indenter]            kind = "sphere" (R) | "ellipsoid" (Rx, Ry)
                           | "flat_punch" (a, edge_radius)
                           | "heightmap" (file = "map.npz" | x, y, z [, symmetric_y])
+                          | "cylinder" (R = 1 only): line contact, see below
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
     [fluid]               beta = 200.0
     [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)
@@ -17,6 +18,13 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           [motion.gap] gives only hc(0)
     [domain]              L = 2.0
     [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions
+
+Line contact (a rigid cylinder, gap x^2/2, on a Winkler foundation; see
+:mod:`femehl.line`): ``[indenter] kind = "cylinder"`` needs ``[substrate]
+kind = "winkler"`` and gives a :class:`femehl.line.LineScene` (k, beta, motion,
+L); its [run] takes method = "line", n_elements, grading ("uniform" or a size
+ratio >= 1), scheme, t_end, dt, store_every.  See
+``examples/cylinder_winkler.toml``.
 
 A height map file is an ``.npz`` with arrays x, y, z (``np.savez``), its path
 relative to the scene file.  ``kind = "shape"`` (a Python function) exists
@@ -49,12 +57,15 @@ try:
 except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
-__all__ = ["load_scene_file", "INDENTERS", "SUBSTRATES", "TIME_FUNCTIONS", "RUN_KEYS"]
+__all__ = ["load_scene_file", "INDENTERS", "SUBSTRATES", "TIME_FUNCTIONS", "RUN_KEYS",
+           "LINE_RUN_KEYS"]
 
 SUBSTRATES = {"halfspace": HalfSpace, "winkler": Winkler, "rigid": Rigid}
 TIME_FUNCTIONS = {"constant": Constant, "table": Table, "ramp_hold": RampHold, "tanh": TanhStart}
 RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions",
             "linear_solver"}
+#: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
+LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading"}
 
 
 def _build(registry, table, where, path):
@@ -105,6 +116,10 @@ def _time_function(value, where, path):
 def load_scene_file(path) -> tuple[Scene, dict]:
     """Read a TOML scene file; return ``(scene, run_options)``.
 
+    A file whose ``[indenter]`` has ``kind = "cylinder"`` states line contact:
+    the scene is then a :class:`femehl.line.LineScene` and the run options
+    those of :func:`femehl.line.solve_line` (see :data:`LINE_RUN_KEYS`).
+
     When the file states the scene in SI units (an ``[si]`` table), the run
     options also hold the :class:`~femehl.scene.Dimensional` under the key
     ``"_dimensional"`` (pop it before passing the options to a solver; the CLI
@@ -132,7 +147,17 @@ def load_scene_file(path) -> tuple[Scene, dict]:
     unknown = set(raw) - known
     if unknown:
         raise SceneFileError(f"{path}: unknown table(s) {sorted(unknown)}; known: {sorted(known)}.")
-    run = dict(raw.get("run", {}))
+    run = raw.get("run", {})
+    if not isinstance(run, dict):
+        raise SceneFileError(f"{path}: [run] must be a table.")
+    run = dict(run)
+    if _is_line(raw):
+        try:
+            return _line_scene(raw, path), _line_run(run, path)
+        except SceneFileError:
+            raise
+        except SceneError as exc:
+            raise SceneFileError(f"{path}: {exc}") from None
     extra = set(run) - RUN_KEYS
     if extra:
         raise SceneFileError(f"{path}: [run] does not take {sorted(extra)}; it takes {sorted(RUN_KEYS)}.")
@@ -197,6 +222,16 @@ def _normalized_scene(raw, path):
     fluid = raw.get("fluid", {})
     if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
         raise SceneFileError(f"{path}: [fluid] takes only beta.")
+    motion = _motion(raw, path)
+    domain = raw.get("domain", {})
+    if not isinstance(domain, dict) or set(domain) - {"L"}:
+        raise SceneFileError(f"{path}: [domain] takes only L.")
+    return Scene(indenter=indenter, substrate=substrate, fluid=Fluid(**fluid),
+                 motion=motion, domain=Domain(**domain))
+
+
+def _motion(raw, path) -> Motion:
+    """[motion.gap], [motion.velocity], [motion.load] -> Motion (shared by 2-D and line scenes)."""
     motion = raw.get("motion", {})
     if not isinstance(motion, dict):
         raise SceneFileError(f"{path}: [motion] must be a table.")
@@ -209,11 +244,72 @@ def _normalized_scene(raw, path):
     load = None
     if "load" in motion:
         load = _time_function(motion["load"], "motion.load", path)
+    return Motion(gap=gap, velocity=vel, load=load)
+
+
+def _is_line(raw) -> bool:
+    ind = raw.get("indenter")
+    return isinstance(ind, dict) and ind.get("kind") == "cylinder"
+
+
+def _line_scene(raw, path):
+    """[indenter] kind = "cylinder": a :class:`femehl.line.LineScene`."""
+    from .line import LineScene
+
+    if "si" in raw:
+        raise SceneFileError(f"{path}: [si] states the sphere experiment; line contact "
+                             "([indenter] kind = \"cylinder\") is stated in normalized units: "
+                             "replace [si] by [substrate], [fluid], [motion] and [domain].")
+    ind = dict(raw["indenter"])
+    ind.pop("kind")
+    extra = set(ind) - {"R"}
+    if extra:
+        raise SceneFileError(f"{path}: [indenter] kind = 'cylinder' does not take {sorted(extra)}; "
+                             "it takes only R (= 1).")
+    if "R" in ind:
+        R = ind["R"]
+        if isinstance(R, bool) or not isinstance(R, (int, float)) or R != 1:
+            raise SceneFileError(
+                f"{path}: [indenter] kind = 'cylinder' has R = {R!r}, but line contact is "
+                "normalized by the cylinder's radius (gap x^2/2): R must be 1.0 (or left out). "
+                "Rescale the other parameters instead.")
+    sub = raw.get("substrate")
+    if not isinstance(sub, dict) or sub.get("kind") != "winkler":
+        got = sub.get("kind") if isinstance(sub, dict) else sub
+        raise SceneFileError(
+            f"{path}: [substrate] kind = {got!r}: line contact needs a Winkler foundation "
+            "([indenter] kind = 'cylinder'); give [substrate] kind = \"winkler\" with k = ..., "
+            "or use a 3-D indenter (e.g. kind = \"sphere\") for other substrates.")
+    winkler = _build(SUBSTRATES, sub, "substrate", path)
+    fluid = raw.get("fluid", {})
+    if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
+        raise SceneFileError(f"{path}: [fluid] takes only beta.")
+    motion = _motion(raw, path)
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
-    return Scene(indenter=indenter, substrate=substrate, fluid=Fluid(**fluid),
-                 motion=Motion(gap=gap, velocity=vel, load=load), domain=Domain(**domain))
+    kw = {"k": winkler.k, "motion": motion}
+    if "beta" in fluid:
+        kw["beta"] = fluid["beta"]
+    if "L" in domain:
+        kw["L"] = domain["L"]
+    try:
+        return LineScene(**kw)
+    except (SceneError, TypeError) as exc:
+        raise SceneFileError(f"{path}: line contact: {exc}") from None
+
+
+def _line_run(run, path):
+    """Check the [run] table of a line-contact scene."""
+    extra = set(run) - LINE_RUN_KEYS
+    if extra:
+        raise SceneFileError(f"{path}: [run] of a line contact ([indenter] kind = 'cylinder') "
+                             f"does not take {sorted(extra)}; it takes {sorted(LINE_RUN_KEYS)}.")
+    method = run.pop("method", "line")
+    if method != "line":
+        raise SceneFileError(f"{path}: [run] method = {method!r}: line contact is solved by "
+                             "method = \"line\" (or leave method out).")
+    return run
 
 
 def run_options(run: dict) -> dict:

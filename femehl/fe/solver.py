@@ -53,7 +53,7 @@ from ..kernels import edge_terms, mesh_edges, triangle_influence
 from ..scene import HalfSpace, Rigid, Scene, Winkler
 from ..stepping import State, get_scheme
 from .forms import couette, film_diffusion, squeeze
-from .mesh import DiskMesh, load_mesh
+from .mesh import DiskMesh, areas, centroids, load_mesh
 
 __all__ = ["FEStepper", "FEDisc", "COMPLIANCE", "compliance_operator"]
 
@@ -71,10 +71,8 @@ class FEDisc:
         p, t = self.mesh.p, self.mesh.t
         self.nodes = p.T.copy()
         self.tri = np.transpose(p[:, t], (2, 1, 0))            # (ne, 3, 2)
-        self.centroids = self.tri.mean(axis=1)
-        a = self.tri
-        self.areas = 0.5 * np.abs((a[:, 1, 0] - a[:, 0, 0]) * (a[:, 2, 1] - a[:, 0, 1])
-                                  - (a[:, 1, 1] - a[:, 0, 1]) * (a[:, 2, 0] - a[:, 0, 0]))
+        self.centroids = centroids(dm)
+        self.areas = areas(dm)
         ne, nn = t.shape[1], p.shape[1]
         # element average of a P1 field: (P p)_e = mean of its 3 nodal values
         self.P = sp.csr_matrix((np.full(3 * ne, 1.0 / 3.0),

@@ -146,7 +146,9 @@ def test_femehl_step_solves_its_weak_form():
     prev = None
     for s in march(st, 1.3, 0.1):
         if prev is not None:
-            assert mass_balance_residual(st, prev, s) < 1e-8
+            # the solver stops at ||b - A p|| <= rtol ||b||; this residual is scaled by the
+            # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound 100 rtol)
+            assert mass_balance_residual(st, prev, s) < 100 * st.rtol
         prev = s
 
 

@@ -86,7 +86,7 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
             last = (state, keep)
             if bar is not None and state.step:
                 bar.update(1)
-                bar.set_postfix(t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}")
+                bar.set_postfix(t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}", refresh=False)
     except SolverError as exc:
         exc.result = result
         log(f"femehl: run stopped at t = {exc.t}: {exc}\n"

@@ -16,6 +16,14 @@ def _plt():
     return plt
 
 
+def _save(plt, fig, path, dpi):
+    fig.tight_layout()
+    path = pathlib.Path(path)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def profile_times(result, wanted=(0.5, 0.8, 1.0, 1.5, 2.0, 5.0)):
     """Times to plot: the paper's figure times that the run reached, plus its end."""
     ts = result.stored_times
@@ -56,11 +64,7 @@ def centreline_png(results, path, times=None, labels=None, L=None):
     ax2.set_yscale("log")
     ax1.legend(fontsize=7, ncol=2)
     ax1.set_title("centreline y = 0")
-    fig.tight_layout()
-    path = pathlib.Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path, dpi=110)
 
 
 def quicklook_png(result, path, t=None):
@@ -88,8 +92,4 @@ def quicklook_png(result, path, t=None):
         ax.set_aspect("equal")
         ax.set_title(f"{name} at t = {state.t:g}")
         ax.set_xlabel("x")
-    fig.tight_layout()
-    path = pathlib.Path(path)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path, dpi=100)

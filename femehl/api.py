@@ -15,7 +15,7 @@ from .result import Result
 from .scene import Scene
 from .stepping import State, march
 
-__all__ = ["SOLVERS", "register_solver", "make_stepper", "steps", "solve"]
+__all__ = ["SOLVERS", "register_solver", "make_stepper", "steps", "solve", "run_loop"]
 
 SOLVERS: dict[str, type] = {}
 
@@ -90,18 +90,38 @@ def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: fl
     from .stepping import check_run
 
     check_run(t_end, dt)
+    stepper = make_stepper(scene, method, **options)
+    return run_loop(stepper, t_end, dt, store_every=store_every, on_state=callback)
+
+
+def run_loop(stepper, t_end: float, dt: float, *, start: State | None = None,
+             store_every: int = 1, on_state: Callable[[State], None] | None = None) -> Result:
+    """The one driver loop: march ``stepper`` and feed every State to a Result and ``on_state``.
+
+    Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
+    here.  ``start`` resumes from a State (its own record is kept, ``on_state`` is not
+    called for it).  If the run stops on a :class:`~femehl.errors.SolverError` or is
+    interrupted, the partial Result is attached to the exception as ``.result`` and
+    the exception propagates; everything fed to ``on_state`` before stays valid.
+    """
+    from .errors import SolverError
+
     if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
         raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
-    stepper = make_stepper(scene, method, **options)
-    result = Result(scene=scene, method=stepper.method, disc=stepper.disc)
+    result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
     last = None
-    for state in march(stepper, t_end, dt):
-        keep = store_every > 0 and state.step % store_every == 0
-        result.record(state, store_fields=keep)
-        if callback is not None:
-            callback(state)
-        last = (state, keep)
-    if last is not None and store_every > 0 and not last[1]:
-        result._stored.append(last[0])
-    result.info.update(getattr(stepper, "info", {}))      # counters as at the end of the run
+    try:
+        for state in march(stepper, t_end, dt, start=start):
+            keep = store_every > 0 and state.step % store_every == 0
+            result.record(state, store_fields=keep)
+            if on_state is not None and state is not start:
+                on_state(state)
+            last = (state, keep)
+    except (SolverError, KeyboardInterrupt) as exc:
+        exc.result = result
+        raise
+    finally:
+        if last is not None and store_every > 0 and not last[1]:
+            result._stored.append(last[0])
+        result.info.update(getattr(stepper, "info", {}))      # counters as at the end of the run
     return result

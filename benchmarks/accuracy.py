@@ -164,8 +164,8 @@ def worker(spec):
     st = make_stepper(scene, spec["solver"], **opts)
     setup = time.perf_counter() - t0
     out = dict(spec)
-    # the dense influence operator in use: FE C (elements x free nodes), FD W (nodes x free)
-    D = st.C if spec["solver"] == "fe" else st.W
+    # the dense influence operator in use: FE elements x free nodes, FD nodes x free nodes
+    D = st.C
     mv = []                      # matvec timings, interleaved with the stepping (same load)
     if isinstance(D, np.ndarray):
         x = np.random.default_rng(0).random(D.shape[1])
@@ -211,10 +211,6 @@ def worker(spec):
               "factor_s", "krylov_s"):
         if k in info:
             out[k] = info[k]
-    if spec["solver"] == "fd":
-        out["unknowns"] = int(st.E.shape[1])
-        out["operator_bytes"] = int(sum(a.nbytes for a in (st.W, st.GW, st.SW)
-                                        if isinstance(a, np.ndarray)))
     xs = np.linspace(*XPROF)
     pts = np.column_stack([xs, np.zeros_like(xs)])
     for T in (1.0, 5.0):

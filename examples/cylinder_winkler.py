@@ -46,7 +46,7 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
     t2 = time.perf_counter()
 
     f = res.final
-    d_ex = ex.film(res.xc)
+    d_ex = ex.film(res.disc.xc)
     out = {
         "t_end": float(f.t),
         "film_error": float(np.abs(f.d - d_ex).max() / d_ex.min()),
@@ -67,11 +67,11 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
     xs = np.linspace(-L, L, 1601)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
     for s in res.states[:: max(1, len(res.states) // 6)]:
-        ax1.plot(res.x, s.p, lw=0.6, alpha=0.5, label=f"t = {s.t:.1f}")
-        ax2.plot(res.xc, s.d, lw=0.6, alpha=0.5)
-    ax1.plot(res.x, f.p, "C0", lw=2, label=f"FE, t = {f.t:g}")
+        ax1.plot(res.disc.x, s.p, lw=0.6, alpha=0.5, label=f"t = {s.t:.1f}")
+        ax2.plot(res.disc.xc, s.d, lw=0.6, alpha=0.5)
+    ax1.plot(res.disc.x, f.p, "C0", lw=2, label=f"FE, t = {f.t:g}")
     ax1.plot(xs, ex.pressure(xs), "k--", lw=1.2, label="exact steady")
-    ax2.plot(res.xc, f.d, "C0", lw=2)
+    ax2.plot(res.disc.xc, f.d, "C0", lw=2)
     ax2.plot(xs, ex.film(xs), "k--", lw=1.2)
     ax2.plot(xs, h_end + xs ** 2 / 2, ":", color="gray", lw=1, label="rigid gap h")
     ax1.set_ylabel("p")

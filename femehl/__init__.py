@@ -13,7 +13,8 @@ reference).  Quick start::
 """
 
 from . import indenters, presets
-from .api import SOLVERS, make_stepper, solve, steps
+from .api import make_stepper, methods, solve, steps
+from .discretizations import METHODS
 from .errors import (FemehlError, FilmRuptureError, MeshError, SceneError, SceneFileError,
                      SingularSystemError, SolverError)
 from .indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
@@ -25,7 +26,7 @@ from .stepping import State, march
 __version__ = "0.1.0"
 
 __all__ = [
-    "presets", "indenters", "solve", "steps", "make_stepper", "march", "SOLVERS", "Result", "State",
+    "presets", "indenters", "solve", "steps", "make_stepper", "march", "METHODS", "methods", "Result", "State",
     "Scene", "Sphere", "Ellipsoid", "FlatPunch", "Shape", "HeightMap", "INDENTERS", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
     "Dimensional", "Constant", "Table", "RampHold", "TanhStart",
     "FemehlError", "SceneError", "SceneFileError", "MeshError", "SolverError",

@@ -1,7 +1,8 @@
 """``femehl.solve``: run a scene with a registered solver and collect a Result.
 
-Solvers are registered in :data:`SOLVERS` (name -> stepper class); tests
-parametrize over this registry.  The stepping itself is the generator
+Methods are discretizations registered in :data:`femehl.discretizations.METHODS`; every
+one is advanced by the same :class:`~femehl.core.stepper.LaggedStepper`, and every run
+goes through :func:`run_loop`.  The stepping itself is the generator
 :func:`femehl.stepping.march`; :func:`steps` exposes it directly.
 """
 
@@ -15,46 +16,55 @@ from .result import Result
 from .scene import Scene
 from .stepping import State, march
 
-__all__ = ["SOLVERS", "register_solver", "make_stepper", "steps", "solve", "run_loop"]
+__all__ = ["make_stepper", "steps", "solve", "run_loop", "methods"]
 
-SOLVERS: dict[str, type] = {}
+def _registry():
+    from .discretizations import METHODS, method_class
 
-
-def register_solver(name: str):
-    """Class decorator adding a stepper class to :data:`SOLVERS` under ``name``."""
-    def deco(cls):
-        SOLVERS[name] = cls
-        return cls
-    return deco
-
-
-def _load_solvers():
-    from .fd.solver import FDStepper
-    SOLVERS.setdefault("fd", FDStepper)
-    try:
-        from .fe.solver import FEStepper
-    except ImportError:  # pragma: no cover - FE module absent
-        return
-    SOLVERS.setdefault("fe", FEStepper)
+    method_class("fe")       # imports the registered discretizations
+    return METHODS
 
 
 DEFAULT_METHOD = "fe"
 
 
-def make_stepper(scene: Scene, method: str | None = None, **options):
-    """Build the stepper of ``method`` for ``scene`` (operators are built here, once)."""
-    _load_solvers()
-    if not isinstance(scene, Scene):
-        raise SceneError(f"scene must be a femehl.Scene, got {type(scene).__name__}.")
-    method = DEFAULT_METHOD if method is None else method
-    if method not in SOLVERS:
-        raise SceneError(f"unknown method {method!r}: choose one of {sorted(SOLVERS)}.")
-    cls = SOLVERS[method]
-    allowed = set(inspect.signature(cls).parameters) - {"scene"}
-    unknown = set(options) - allowed
+def make_stepper(scene, method: str | None = None, **options):
+    """Build the stepper of ``method`` for ``scene`` (operators are built here, once).
+
+    ``options`` are split between the discretization (its constructor's parameters, e.g.
+    FE ``mesh``, FD ``dr``, line ``n_elements``) and the one stepper
+    (:class:`femehl.core.stepper.LaggedStepper`: ``scheme``, ``linear_solver``, ``terms``
+    and the linear solver's ``rtol``, ``refactor_after``, ``recycle``).
+    """
+    from .core.linsolve import LINEAR_SOLVERS
+    from .core.stepper import LaggedStepper
+    from .line import LineScene
+
+    methods = _registry()
+    if not isinstance(scene, (Scene, LineScene)):
+        raise SceneError(f"scene must be a femehl.Scene (or femehl.line.LineScene), got "
+                         f"{type(scene).__name__}.")
+    if method is None:
+        method = "line" if isinstance(scene, LineScene) else DEFAULT_METHOD
+    if not isinstance(method, str) or method not in methods:
+        raise SceneError(f"unknown method {method!r}: choose one of {sorted(methods)}.")
+    cls = methods[method]
+    disc_keys = set(inspect.signature(cls).parameters) - {"scene"}
+    solver_keys = set()
+    for sol in LINEAR_SOLVERS.values():
+        solver_keys |= set(inspect.signature(sol).parameters)
+    step_keys = {"scheme", "linear_solver", "terms"} | solver_keys
+    unknown = set(options) - disc_keys - step_keys
     if unknown:
-        raise SceneError(f"method {method!r} does not take {sorted(unknown)}; it takes {sorted(allowed)}.")
-    return cls(scene, **options)
+        raise SceneError(f"method {method!r} does not take {sorted(unknown)}; it takes "
+                         f"{sorted(disc_keys | step_keys)}.")
+    disc = cls(scene, **{k: v for k, v in options.items() if k in disc_keys})
+    return LaggedStepper(disc, **{k: v for k, v in options.items() if k in step_keys})
+
+
+def methods() -> list[str]:
+    """Names of the registered methods."""
+    return sorted(_registry())
 
 
 def steps(scene: Scene, t_end: float, dt: float, method: str | None = None,
@@ -74,8 +84,9 @@ def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: fl
     scene : femehl.Scene
         The problem (see :mod:`femehl.scene`, :mod:`femehl.presets`).
     method : str, default: "fe"
-        A key of :data:`SOLVERS`: "fe" (finite elements, default) or "fd"
-        (the paper's polar finite differences).
+        A key of :data:`femehl.discretizations.METHODS`: "fe" (finite elements, default
+        for a 2-D scene), "fd" (the paper's polar finite differences) or "line" (line
+        contact, the default for a :class:`femehl.line.LineScene`).
     t_end : float, default: 5.0
         End time (normalized).
     dt : float, default: 0.01
@@ -124,4 +135,5 @@ def run_loop(stepper, t_end: float, dt: float, *, start: State | None = None,
         if last is not None and store_every > 0 and not last[1]:
             result._stored.append(last[0])
         result.info.update(getattr(stepper, "info", {}))      # counters as at the end of the run
+        result.info["steps"] = result.nsteps
     return result

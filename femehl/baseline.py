@@ -13,8 +13,7 @@ equation and elasticity with an under-relaxation factor on the pressure
     until ||p* - p_old|| / ||p*|| < tol        (at most max_iter times)
 
 It is built on the FE discretization (same mesh, same operators K, Bx, M and
-C of :class:`femehl.fe.solver.FEStepper`, which it wraps and does not
-modify), so the only difference to femehl's scheme is *how* one time step is
+C of femehl's stepper for method "fe", which it wraps and does not modify), so the only difference to femehl's scheme is *how* one time step is
 solved: a fixed-point iteration between Reynolds and elasticity, converged
 to a fully implicit step (K evaluated at d^{k+1}), instead of ONE linear
 system with the coefficients lagged.  A step that does not converge raises
@@ -44,25 +43,27 @@ __all__ = ["RelaxationStepper", "mass_balance_residual"]
 
 
 def mass_balance_residual(stepper, prev: State, new: State, coefficient: str = "lagged") -> float:
-    """Relative residual of the FE weak form of one step, from the States alone.
+    """Relative residual of the discrete Reynolds equation of one step, from the States alone.
 
-    ``|| beta K(d*) p + V Bx d + M (d - d^k)/dt || / (|| M (d - d^k)/dt || + || V Bx d ||)``
+    ``|| beta D(d*) p + V X d + T (d - d^k)/dt || / (|| T (d - d^k)/dt || + || V X d ||)``
 
-    with ``d = new.d``, ``d^k = prev.d``, ``p`` the free pressure of ``new`` and
-    ``d* = d^k`` (``coefficient="lagged"``: femehl's Euler scheme) or ``d* = d``
-    (``"implicit"``: the equation the relaxation baseline converges to).
-    ``stepper`` is an :class:`~femehl.fe.solver.FEStepper` (or a
-    :class:`RelaxationStepper`) of the run.  Returns 0 when both terms vanish.
+    with the discretization's operators (:mod:`femehl.core.terms`: FE weak form or FD
+    node equations), ``d = new.d``, ``d^k = prev.d``, ``p`` the pressure unknowns of
+    ``new`` and ``d* = d^k`` (``coefficient="lagged"``: femehl's Euler scheme) or
+    ``d* = d`` (``"implicit"``: the equation the relaxation baseline converges to).
+    ``stepper`` is a stepper of the run (any method) or a :class:`RelaxationStepper`.
+    Returns 0 when both terms vanish.
     """
-    fe = getattr(stepper, "fe", stepper)
+    disc = getattr(stepper, "fe", stepper).disc
     dt = new.t - prev.t
-    p = np.asarray(new.p)[fe.free]
+    p = np.asarray(new.p)[disc.free_index]
     d_coef = prev.d if coefficient == "lagged" else new.d
-    squeeze = fe.M @ (new.d - prev.d) / dt
+    squeeze = disc.squeeze() @ (new.d - prev.d) / dt
     couette = np.zeros_like(squeeze)
     if new.V != 0.0:
-        couette = new.V * (fe.couette()[0] @ new.d)
-    r = fe.beta * (fe.stiffness(d_coef) @ p) + couette + squeeze
+        couette = new.V * (disc.couette() @ new.d)
+    D = disc.poiseuille(d_coef, d_coef ** 3, 3.0 * d_coef ** 2)
+    r = stepper.scene.fluid.beta * (D @ p) + couette + squeeze
     scale = float(np.linalg.norm(squeeze) + np.linalg.norm(couette))
     rn = float(np.linalg.norm(r))
     if scale == 0.0:
@@ -78,7 +79,7 @@ class RelaxationStepper:
     scene : femehl.scene.Scene
         Imposed-gap scenes only (the baseline has no load row).
     mesh : str or mesh, default: "coarse"
-        As for :class:`femehl.fe.solver.FEStepper`.
+        As for method "fe".
     omega : float, default: 0.1
         Under-relaxation factor on the pressure, 0 < omega <= 1.
     tol : float, default: 1e-6
@@ -86,7 +87,7 @@ class RelaxationStepper:
     max_iter : int, default: 200
         Iterations allowed per step before :class:`RelaxationDivergedError`.
     **fe_options
-        Passed to :class:`~femehl.fe.solver.FEStepper` (e.g. ``half``).
+        Passed to the FE discretization (e.g. ``half``).
 
     ``info`` counts ``iterations`` (total) and ``steps``; every State's
     ``info["iterations"]`` is that step's count.
@@ -96,7 +97,7 @@ class RelaxationStepper:
 
     def __init__(self, scene: Scene, mesh="coarse", omega: float = 0.1, tol: float = 1e-6,
                  max_iter: int = 200, **fe_options):
-        from .fe.solver import FEStepper
+        from .api import make_stepper
 
         try:
             omega = float(omega)
@@ -111,13 +112,14 @@ class RelaxationStepper:
             raise SceneError(f"max_iter must be an integer >= 1, got {max_iter!r}.")
         if scene.motion.load_controlled:
             raise SceneError("the relaxation baseline handles imposed-gap scenes only.")
-        self.fe = FEStepper(scene, mesh=mesh, **fe_options)
+        self.fe = make_stepper(scene, "fe", mesh=mesh, **fe_options)
         self.scene = scene
         self.disc = self.fe.disc
         self.omega = omega
         self.tol = tol
         self.max_iter = max_iter
         self.info = dict(self.fe.info)
+        self._Bx = None
         self.info.update(method="relax", omega=omega, tol=tol, max_iter=max_iter,
                          iterations=0, steps=0, max_step_iterations=0)
 
@@ -131,8 +133,12 @@ class RelaxationStepper:
         fe = self.fe
         mo = self.scene.motion
         hc, V = mo.hc(t_new), mo.V(t_new)
-        Bx = fe.couette()[0] if V != 0.0 else None
-        p = np.asarray(state.p)[fe.free].copy()
+        disc = fe.disc
+        if V != 0.0 and self._Bx is None:
+            self._Bx = disc.couette()
+        Bx = self._Bx if V != 0.0 else None
+        M = disc.squeeze()
+        p = np.asarray(state.p)[disc.free_index].copy()
         d_old = state.d
         it = 0
         change = math.inf
@@ -147,10 +153,10 @@ class RelaxationStepper:
                     f"iterations: the iterate's film became {d[bad]:.3g} <= 0 at (x, y) = "
                     f"({x:.3g}, {y:.3g}). Try a smaller omega (more iterations) -- or femehl's "
                     "non-iterative scheme (method 'fe').", t=t_new, iterations=it)
-            rhs = -fe.M @ (d - d_old) / dt
+            rhs = -M @ (d - d_old) / dt
             if Bx is not None:
                 rhs -= V * (Bx @ d)
-            K = fe.stiffness(d)
+            K = disc.poiseuille(d, d ** 3)
             p_star = spla.spsolve((fe.beta * K).tocsc(), rhs)
             ns = float(np.linalg.norm(p_star))
             change = float(np.linalg.norm(p_star - p)) / ns if ns > 0.0 else (

@@ -180,8 +180,8 @@ def _line_png(res, path):
     for i, s in enumerate(states):
         last = s is res.final
         kw = dict(lw=2 if last else 0.8, alpha=1.0 if last else 0.6, label=f"t = {s.t:.3g}")
-        ax1.plot(res.x, s.p, **kw)
-        ax2.plot(res.xc, s.d, **kw)
+        ax1.plot(res.disc.x, s.p, **kw)
+        ax2.plot(res.disc.xc, s.d, **kw)
     ax1.set_ylabel("p")
     ax2.set_ylabel("d")
     ax2.set_xlabel("x  (cylinder slides toward +x)")

@@ -57,22 +57,18 @@ alone.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from skfem import Basis, ElementLineP0, ElementLineP1, MeshLine, asm
 
-from .errors import SceneError, SingularSystemError
-from .fe.forms import couette, film_diffusion, squeeze
-from .scene import (Constant, Motion, RampHold, Table, TanhStart, _as_time_function,
+from .errors import SceneError
+from .scene import (Constant, Fluid, Motion, RampHold, Table, _as_time_function, TanhStart,
                     check_finite, check_positive)
-from .stepping import State, get_scheme, march
+from .stepping import State
+from .substrates import Winkler
 
-__all__ = ["LineScene", "LineStepper", "LineResult", "line_nodes", "solve_line"]
+__all__ = ["LineScene", "line_nodes", "solve_line"]
 
 
 def _default_motion() -> Motion:
@@ -128,6 +124,8 @@ class LineScene:
         if self.load is not None:
             object.__setattr__(self, "load", _as_time_function("LineScene load F(t)", self.load))
             check_finite("load F(t=0)", self.load(0.0), "The load history must return finite values.")
+            object.__setattr__(self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity,
+                                                      load=self.load))
         hc0 = self.motion.hc(0.0)
         if hc0 <= 0.0:
             raise SceneError(
@@ -140,6 +138,16 @@ class LineScene:
                 f"domain half length L = {self.L:g} is too small to hold the contact: the dry "
                 f"Winkler contact of this run reaches |x| = {a:.3g}, and the pressure must decay "
                 f"before x = +-L. Use L >= {1.5 * a:.3g}.")
+
+    @property
+    def fluid(self) -> Fluid:
+        """The film's fluid (its ``beta``), as for a 2-D scene."""
+        return Fluid(self.beta)
+
+    @property
+    def substrate(self) -> Winkler:
+        """The Winkler foundation ``w = -p/k``, as for a 2-D scene."""
+        return Winkler(self.k)
 
     @property
     def imposed_load(self) -> bool:
@@ -243,255 +251,18 @@ def line_nodes(L: float, n_elements: int, grading="uniform", fine: float | None 
 
 
 # --------------------------------------------------------------------------
-# stepper
+# running: line contact is the registered method "line" of the one core
 # --------------------------------------------------------------------------
-class LineStepper:
-    """Advance the line-contact FE discretization by one lagged sparse linear step.
-
-    Parameters
-    ----------
-    scene : LineScene
-    n_elements : int, default: 400
-        Number of P1 elements on ``[-L, L]``.
-    grading : "uniform", float or callable, default: 3.0
-        Mesh grading, see :func:`line_nodes`.  The default makes elements 3
-        times smaller over the contact (``|x| <= fine``) than at the ends.
-    fine : float, optional
-        Half width of the fine zone; default ``min(L, a + 0.5)`` with ``a`` the
-        dry contact half width (:meth:`LineScene.contact_halfwidth`), or ``L/2``.
-    scheme : {"euler", "bdf2"}, default: "euler"
-        "euler" is the paper's scheme (backward Euler, d^3 lagged one step);
-        "bdf2" is second order in time (:data:`femehl.stepping.SCHEMES`) but
-        less robust: for k = 1, beta = 10, hc = -0.5 it kept oscillating at
-        dt = 0.2 (settled at dt <= 0.1), where "euler" settles up to dt = 0.5.
-
-    Attributes
-    ----------
-    x, xc : numpy.ndarray
-        Nodes and element centroids.
-    free : numpy.ndarray
-        Indices of the interior nodes (the pressure unknowns).
-    matrix_format : str
-        Sparse format of the step matrix ("csc").
-    """
-
-    method = "line"
-    matrix_format = "csc"
-
-    def __init__(self, scene: LineScene, n_elements: int = 400, grading=3.0, fine=None,
-                 scheme: str = "euler"):
-        t0 = time.perf_counter()
-        if not isinstance(scene, LineScene):
-            raise SceneError(f"scene must be a femehl.line.LineScene, got {type(scene).__name__}.")
-        self.scene = scene
-        self.scheme = get_scheme(scheme)
-        if fine is None and not isinstance(grading, str):
-            a = scene.contact_halfwidth()
-            fine = 0.5 * scene.L if a is None else min(scene.L, a + 0.5)
-        x = line_nodes(scene.L, n_elements, grading, fine)
-        self.mesh = MeshLine(x)
-        b1 = Basis(self.mesh, ElementLineP1())
-        b0 = b1.with_element(ElementLineP0())
-        self.basis, self.basis0 = b1, b0
-        t = self.mesh.t
-        self.x = self.mesh.p[0].copy()
-        self.xc = self.x[t].mean(axis=0)
-        ne, nn = t.shape[1], self.x.size
-        self.nelements, self.nnodes = ne, nn
-        # element average of a P1 field
-        self.P = sp.csr_matrix((np.full(2 * ne, 0.5), (np.repeat(np.arange(ne), 2), t.T.ravel())),
-                               shape=(ne, nn))
-        self.free = np.setdiff1d(np.arange(nn), self.mesh.boundary_nodes())
-        free = self.free
-        self.beta, self.k = scene.beta, scene.k
-        self.shape = scene.shape(self.xc)
-        # unit-coefficient element stiffness; K(d) scales element e by d_e^3
-        kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(ne)))
-        self._k_rows, self._k_cols = kcoo.indices
-        self._k_data = kcoo.data.reshape(-1, ne)
-        Mall = asm(squeeze, b0, b1).tocsr()
-        self.Bx = asm(couette, b0, b1).tocsr()[free]               # (nfree, ne)
-        self.M = Mall[free]
-        self.node_weight = np.asarray(Mall.sum(axis=1)).ravel()    # int phi_q dx
-        self.C = (self.P[:, free] / self.k).tocsr()                # (P p)/k on elements
-        self.BxC = (self.Bx @ self.C).tocsr()
-        self.MC = (self.M @ self.C).tocsr()
-        ones = np.ones(ne)
-        self._hc_col = (self.Bx @ ones, self.M @ ones)             # d(rows)/d(hc): V Bx1 + M1/dt
-        self.info = {
-            "method": self.method, "elements": ne, "nodes": nn, "unknowns": int(free.size)
-            + int(scene.imposed_load), "grading": grading if not callable(grading) else "callable",
-            "h_min": float(np.diff(self.x).min()), "h_max": float(np.diff(self.x).max()),
-            "imposed_load": scene.imposed_load, "scheme": self.scheme.name,
-            "setup_s": time.perf_counter() - t0,
-        }
-
-    # ---- operators ----------------------------------------------------------
-    def stiffness(self, d: np.ndarray):
-        """K(d)[q, p] = int d^3 p' q' on the free nodes (d element-constant)."""
-        data = (self._k_data * (np.asarray(d, dtype=float) ** 3)[None, :]).ravel()
-        n = self.nnodes
-        K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
-        return K[self.free][:, self.free]
-
-    def assemble(self, state: State, t_new: float, dt: float):
-        """The sparse system ``A u = b`` of the step from ``state`` to ``t_new``.
-
-        ``u`` is the free nodal pressure, followed by hc^{k+1} under an imposed
-        load.  ``A`` is a scipy sparse matrix in :attr:`matrix_format`.  With
-        the scheme's coefficients (Euler: a0 = a1 = l0 = 1, a2 = l1 = 0)
-
-            A = beta K(l0 d^k - l1 d^{k-1}) + V Bx C + (a0/dt) M C
-            b = -V Bx h - M (a0 h - a1 d^k + a2 d^{k-1}) / dt.
-        """
-        sc = self.scene
-        V = sc.motion.V(t_new)
-        omega = None if state.d_prev is None or not state.dt_prev else dt / state.dt_prev
-        a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
-        if l1 == 0.0:
-            d_lag, hist = state.d, state.d
-        else:   # extrapolated coefficient, kept positive as in the FE solver
-            d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
-            hist = a1 * state.d - a2 * state.d_prev
-        c = a0 / dt
-        A = self.beta * self.stiffness(d_lag) + V * self.BxC + c * self.MC
-        if not sc.imposed_load:
-            h = sc.motion.hc(t_new) + self.shape
-            b = -V * (self.Bx @ h) - self.M @ (a0 * h - hist) / dt
-            return A.asformat(self.matrix_format), b
-        F = check_finite(f"load F(t={t_new:g})", sc.load(t_new),
-                         "The load history must return finite values.")
-        col = V * self._hc_col[0] + c * self._hc_col[1]
-        row = self.node_weight[self.free]
-        A = sp.bmat([[A, sp.csr_matrix(col[:, None])], [sp.csr_matrix(row[None, :]), None]])
-        b = np.concatenate([-V * (self.Bx @ self.shape) - self.M @ (a0 * self.shape - hist) / dt, [F]])
-        return A.asformat(self.matrix_format), b
-
-    # ---- stepping -----------------------------------------------------------
-    def _state(self, step, t, hc, V, p_free, info=None, d_prev=None, dt_prev=None) -> State:
-        p = np.zeros(self.nnodes)
-        p[self.free] = p_free
-        Pp = self.P @ p
-        w = -Pp / self.k
-        d = hc + self.shape - w
-        i_min, i_max = int(np.argmin(d)), int(np.argmax(p))
-        p0 = float(np.interp(0.0, self.x, p))
-        return State(step=step, t=t, hc=float(hc), V=float(V), p=p, w=w, d=d,
-                     load=float(self.node_weight @ p), film_center=float(hc) + p0 / self.k,
-                     film_min=float(d[i_min]), film_min_at=(float(self.xc[i_min]), 0.0),
-                     p_max=float(p[i_max]), p_max_at=(float(self.x[i_max]), 0.0),
-                     info=info or {}, d_prev=d_prev, dt_prev=dt_prev)
-
-    def initial_state(self) -> State:
-        """p = 0 at t = 0, so d = hc(0) + x^2/2."""
-        mo = self.scene.motion
-        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.free.size))
-
-    def step(self, state: State, t_new: float, dt: float) -> State:
-        """One lagged step: assemble the sparse system and solve it once."""
-        A, b = self.assemble(state, t_new, dt)
-        try:
-            u = spla.splu(A).solve(b)
-        except RuntimeError as exc:
-            raise SingularSystemError(
-                f"line step at t = {t_new:.6g}: the sparse system is singular ({exc}). "
-                "Try a smaller dt or more elements.", t=t_new) from None
-        if not np.all(np.isfinite(u)):
-            raise SingularSystemError(
-                f"line step at t = {t_new:.6g} produced non-finite values: the system is "
-                "ill-conditioned. Try a smaller dt or more elements.", t=t_new)
-        bn = float(np.linalg.norm(b))
-        res = float(np.linalg.norm(A @ u - b)) / bn if bn > 0 else 0.0
-        mo = self.scene.motion
-        if self.scene.imposed_load:
-            p_free, hc = u[:-1], float(u[-1])
-        else:
-            p_free, hc = u, mo.hc(t_new)
-        return self._state(state.step + 1, t_new, hc, mo.V(t_new), p_free,
-                           info={"residual": res}, d_prev=state.d, dt_prev=dt)
-
-
-# --------------------------------------------------------------------------
-# driver and result
-# --------------------------------------------------------------------------
-@dataclass(frozen=True)
-class LineResult:
-    """Per-step arrays of a line-contact run, the stored states and the mesh.
-
-    Attributes
-    ----------
-    t, hc, V, load, film_center, film_min, film_min_x, p_max : numpy.ndarray
-        One entry per step (the initial state first).
-    states : tuple of femehl.stepping.State
-        Stored states (every ``store_every``-th step and the last one).
-    x, xc : numpy.ndarray
-        Mesh nodes (where ``State.p`` lives) and centroids (``State.d``, ``State.w``).
-    """
-
-    scene: LineScene
-    t: np.ndarray
-    hc: np.ndarray
-    V: np.ndarray
-    load: np.ndarray
-    film_center: np.ndarray
-    film_min: np.ndarray
-    film_min_x: np.ndarray
-    p_max: np.ndarray
-    states: tuple
-    x: np.ndarray
-    xc: np.ndarray
-    info: dict = field(default_factory=dict)
-
-    @property
-    def final(self) -> State:
-        """The last state of the run."""
-        return self.states[-1]
-
-    def state_at(self, t: float) -> State:
-        """The stored state closest in time to ``t``."""
-        ts = np.array([s.t for s in self.states])
-        return self.states[int(np.argmin(np.abs(ts - t)))]
-
-
 def solve_line(scene: LineScene, t_end: float, dt: float, *, store_every: int = 1,
-               callback: Callable[[State], None] | None = None, **opts) -> LineResult:
-    """Run a line-contact scene from t = 0 to ``t_end`` with steps ``dt``.
+               callback: Callable[[State], None] | None = None, **opts):
+    """Run a line-contact scene: ``femehl.solve(scene, method="line", ...)``.
 
-    Parameters
-    ----------
-    scene : LineScene
-    t_end, dt : float
-        End time and time step (normalized; the last step is shortened to end at t_end).
-    store_every : int, default: 1
-        Keep the fields of every ``store_every``-th state (the last one always).
-    callback : callable, optional
-        Called with every state as it is produced.
-    **opts
-        Passed to :class:`LineStepper` (``n_elements``, ``grading``, ``fine``, ``scheme``).
-
-    Returns
-    -------
-    LineResult
+    ``opts`` are the discretization's (``n_elements``, ``grading``, ``fine``, see
+    :class:`femehl.discretizations.fe_line.LineDisc`) and the stepper's (``scheme``).
+    Returns a :class:`femehl.result.Result`; its ``disc.x`` / ``disc.xc`` are the nodes
+    (where ``State.p`` lives) and the element centroids (``State.d``, ``State.w``).
     """
-    if isinstance(store_every, bool) or not isinstance(store_every, (int, np.integer)) or store_every < 1:
-        raise SceneError(f"store_every must be an integer >= 1, got {store_every!r}.")
-    t0 = time.perf_counter()
-    stepper = LineStepper(scene, **opts)
-    rows = {k: [] for k in ("t", "hc", "V", "load", "film_center", "film_min", "film_min_x", "p_max")}
-    stored = []
-    last = None
-    for s in march(stepper, t_end, dt):
-        for k in ("t", "hc", "V", "load", "film_center", "film_min", "p_max"):
-            rows[k].append(getattr(s, k))
-        rows["film_min_x"].append(s.film_min_at[0])
-        if s.step % store_every == 0:
-            stored.append(s)
-        if callback is not None:
-            callback(s)
-        last = s
-    if stored[-1] is not last:
-        stored.append(last)
-    info = dict(stepper.info)
-    info.update(steps=last.step, dt=float(dt), run_s=time.perf_counter() - t0)
-    return LineResult(scene=scene, states=tuple(stored), x=stepper.x.copy(), xc=stepper.xc.copy(),
-                      info=info, **{k: np.asarray(v, dtype=float) for k, v in rows.items()})
+    from .api import solve
+
+    return solve(scene, method="line", t_end=t_end, dt=dt, store_every=store_every,
+                 callback=callback, **opts)

@@ -66,6 +66,13 @@ class Result:
         return np.array([s.t for s in self._stored])
 
     @property
+    def final(self) -> State:
+        """The last stored state of the run."""
+        if not self._stored:
+            raise SceneError("this result stored no fields: run with store_every >= 1.")
+        return self._stored[-1]
+
+    @property
     def states(self) -> list:
         """The stored states, in time order."""
         return list(self._stored)

@@ -34,6 +34,7 @@ from typing import Callable, Protocol, runtime_checkable
 import numpy as np
 
 from .errors import SceneError
+from .substrates import HalfSpace, Rigid, Winkler  # noqa: F401  (re-exported)
 from .indenters import Sphere  # indenters live in femehl.indenters; Sphere stays importable here
 
 __all__ = [
@@ -204,41 +205,7 @@ def _as_time_function(name: str, f) -> Callable[[float], float]:
 # --------------------------------------------------------------------------
 # substrates
 # --------------------------------------------------------------------------
-@dataclass(frozen=True)
-class HalfSpace:
-    """Elastic half space (Boussinesq, Eq. 3 / 10b).  ``compliance = 2 (1 - nu)``."""
-
-    nu: float = 0.5
-    kind = "halfspace"
-
-    def __post_init__(self):
-        nu = check_finite("Poisson ratio nu", self.nu)
-        object.__setattr__(self, "nu", nu)
-        if not (-1.0 < nu <= 0.5):
-            raise SceneError(f"Poisson ratio nu must lie in (-1, 0.5], got {nu}.")
-
-    @property
-    def compliance(self) -> float:
-        """Factor multiplying the normalized Boussinesq integral (1 for nu = 0.5)."""
-        return 2.0 * (1.0 - self.nu)
-
-
-@dataclass(frozen=True)
-class Rigid:
-    """Rigid substrate: w = 0, no elastic operator at all."""
-
-    kind = "rigid"
-
-
-@dataclass(frozen=True)
-class Winkler:
-    """Winkler foundation: ``w = -p / k`` (local, diagonal)."""
-
-    k: float = 1.0
-    kind = "winkler"
-
-    def __post_init__(self):
-        object.__setattr__(self, "k", check_positive("Winkler stiffness k", self.k))
+# HalfSpace, Rigid, Winkler live in femehl.substrates (each owns its operator)
 
 
 # --------------------------------------------------------------------------

@@ -1,8 +1,8 @@
 """The time loop as a generator of :class:`State`, shared by every solver.
 
-A *stepper* (one per discretization: ``femehl.fd.FDStepper``,
-``femehl.fe.FEStepper``) knows how to build its operators once and how to
-advance one step; this module only walks time.  The scheme is the paper's
+A *stepper* (:class:`femehl.core.stepper.LaggedStepper`, the same for every
+method) builds its operators once and advances one step; this module only
+walks time.  The scheme is the paper's
 (section 3): every nonlinear coefficient is lagged one step, so each step is
 ONE linear solve.  ``march`` yields the initial state and then one state per
 step, so a caller can stop, store or plot whenever it likes.
@@ -58,7 +58,7 @@ class Stepper(Protocol):
 
 def check_run(t_end, dt):
     """Validate a run's horizon and step; return them as floats and the step count."""
-    from .scene import check_positive
+    from .validation import check_positive
 
     t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
     dt = check_positive("dt", dt, "Give a positive time step (the paper uses 0.01).")
@@ -133,12 +133,22 @@ def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None)
         yield state
 
 
+def _film_floor(state: State):
+    """The thinnest film the step knows of, and where: film points, origin, probed nodes."""
+    cands = [(state.film_min, tuple(state.film_min_at), "the film points"),
+             (state.film_center, (0.0, 0.0), "the origin")]
+    if "node_film_min" in state.info:
+        cands.append((state.info["node_film_min"], tuple(state.info["node_film_min_at"]), "a node"))
+    bad = [c for c in cands if not math.isfinite(c[0])]
+    return bad[0] if bad else min(cands, key=lambda c: c[0])
+
+
 def _check_film(state: State):
-    if not (math.isfinite(state.film_min) and state.film_min > 0.0):
-        x, y = state.film_min_at
+    d, (x, y), where = _film_floor(state)
+    if not (math.isfinite(d) and d > 0.0):
         raise FilmRuptureError(
-            f"film thickness reached {state.film_min:.3g} <= 0 at t = {state.t:.6g}, "
+            f"film thickness reached {d:.3g} <= 0 at t = {state.t:.6g}, at {where} "
             f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
             "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
             "load truly squeezes the film out, the lubricated model no longer applies.",
-            t=state.t, where=(x, y), d_min=state.film_min)
+            t=state.t, where=(x, y), d_min=d)

@@ -25,7 +25,10 @@ import pytest
 import scipy.sparse as sp
 
 from femehl.errors import SceneError
-from femehl.line import LineResult, LineScene, LineStepper, line_nodes, solve_line
+from femehl.api import make_stepper
+from femehl.core.terms import StepContext
+from femehl.line import LineScene, line_nodes, solve_line
+from femehl.result import Result
 from femehl.line_steady import steady_line, steady_line_load
 from femehl.scene import Constant, Motion, RampHold, TanhStart
 from femehl.stepping import State
@@ -53,7 +56,7 @@ def runs():
 
 def errors(res, ex):
     f = res.final
-    de = ex.film(res.xc)
+    de = ex.film(res.disc.xc)
     return np.abs(f.d - de).max() / de.min(), abs(f.load - ex.load) / ex.load
 
 
@@ -101,7 +104,7 @@ def test_transient_reaches_exact_steady_state(runs, exact):
     assert e[400][1] < 2e-6, e
     assert film_order > 1.6 and load_order > 1.6, (film_order, load_order)
     for r in runs.values():
-        assert isinstance(r, LineResult)
+        assert isinstance(r, Result)
         assert np.all(r.film_min > 0)                       # the film never closed
         i = np.searchsorted(r.t, 14.0)
         assert abs(r.load[-1] - r.load[i]) < 1e-8            # steady: nothing changes
@@ -123,16 +126,16 @@ def test_result_arrays_and_states(runs):
     r = runs[200]
     n = r.t.size
     assert n == 301 and r.t[0] == 0.0 and r.t[-1] == pytest.approx(15.0)
-    for a in (r.hc, r.V, r.load, r.film_center, r.film_min, r.film_min_x, r.p_max):
+    for a in (r.hc, r.V, r.load, r.film_center, r.film_min, r.summary()["film_min_x"], r.p_max):
         assert a.shape == (n,)
-    assert r.x.size == 201 and r.xc.size == 200
+    assert r.disc.x.size == 201 and r.disc.xc.size == 200
     assert r.states[0].step == 0 and r.states[-1].step == 300
     s = r.state_at(7.0)
     assert isinstance(s, State) and s.t == pytest.approx(7.0)
-    assert s.p.shape == r.x.shape and s.d.shape == r.xc.shape and s.w.shape == r.xc.shape
+    assert s.p.shape == r.disc.x.shape and s.d.shape == r.disc.xc.shape and s.w.shape == r.disc.xc.shape
     assert s.p[0] == 0.0 and s.p[-1] == 0.0
-    assert np.allclose(s.d, s.hc + r.xc ** 2 / 2 - s.w)
-    assert s.load == pytest.approx(np.trapezoid(s.p, r.x), rel=1e-12)   # P1: trapezoid is exact
+    assert np.allclose(s.d, s.hc + r.disc.xc ** 2 / 2 - s.w)
+    assert s.load == pytest.approx(np.trapezoid(s.p, r.disc.x), rel=1e-12)   # P1: trapezoid is exact
 
 
 # ---------------------------------------------------------------------------
@@ -238,19 +241,23 @@ def test_load_function_of_time():
 @pytest.mark.parametrize("load", [None, 1.0])
 def test_step_matrix_is_sparse(load):
     motion = Motion(gap=0.1, velocity=TanhStart(1.0, 1.0)) if load else sliding_scene().motion
-    st = LineStepper(sliding_scene(motion=motion, load=load), n_elements=300)
+    st = make_stepper(sliding_scene(motion=motion, load=load), "line", n_elements=300)
     s0 = st.initial_state()
-    A, b = st.assemble(s0, 1.5, 0.05)
-    n = st.free.size + (1 if load else 0)
-    assert sp.issparse(A) and A.format == st.matrix_format == "csc"
-    assert A.shape == (n, n) and b.shape == (n,)
-    assert A.nnz <= 3 * n + 2 * n                                # tridiagonal (+ a border)
-    for name, v in vars(st).items():
-        if isinstance(v, np.ndarray):                            # O(n) data, no dense operator
-            assert v.size <= 4 * st.nelements, name
-        elif sp.issparse(v):
-            assert v.nnz <= 4 * max(v.shape), name
     s1 = st.step(s0, 0.05, 0.05)
+    ctx = StepContext(t_new=1.5, dt=0.05, a0=1.0, d=s1.d, d_lag=s1.d, history=s1.d,
+                      p=s1.p[st.disc.free], V=0.5, beta=st.beta)
+    op, b = st.operator(ctx)
+    A = op.matrix()
+    n = st.disc.n
+    assert sp.issparse(A) and A.format == "csc" and not op.dense
+    assert A.shape == (n, n) and b.shape == (n,)
+    assert A.nnz <= 3 * n                                        # tridiagonal
+    for obj in (st, st.disc):
+        for name, v in vars(obj).items():
+            if isinstance(v, np.ndarray):                        # O(n) data, no dense operator
+                assert v.ndim == 1 or v.size <= 4 * st.disc.nelements, name
+            elif sp.issparse(v):
+                assert v.nnz <= 4 * max(v.shape), name
     assert isinstance(s1, State) and s1.step == 1
 
 
@@ -295,23 +302,23 @@ def test_invalid_scene(kw, match):
 def test_invalid_run_options():
     sc = sliding_scene()
     with pytest.raises(SceneError, match="n_elements"):
-        LineStepper(sc, n_elements=2)
+        make_stepper(sc, "line", n_elements=2)
     with pytest.raises(SceneError, match="n_elements"):
-        LineStepper(sc, n_elements=100.5)
+        make_stepper(sc, "line", n_elements=100.5)
     with pytest.raises(SceneError, match="grading"):
-        LineStepper(sc, grading=0.5)
+        make_stepper(sc, "line", grading=0.5)
     with pytest.raises(SceneError, match="grading"):
-        LineStepper(sc, grading="graded")
+        make_stepper(sc, "line", grading="graded")
     with pytest.raises(SceneError, match="rho"):
-        LineStepper(sc, grading=lambda x: -1.0 + 0 * x)
+        make_stepper(sc, "line", grading=lambda x: -1.0 + 0 * x)
     with pytest.raises(SceneError, match="LineScene"):
-        LineStepper(object())
+        make_stepper(object(), "line")
     with pytest.raises(SceneError, match="scheme"):
-        LineStepper(sc, scheme="rk4")
+        make_stepper(sc, "line", scheme="rk4")
     with pytest.raises(SceneError, match="dt"):
         solve_line(sc, 1.0, -0.1)
     with pytest.raises(SceneError, match="store_every"):
-        solve_line(sc, 1.0, 0.1, store_every=0)
+        solve_line(sc, 1.0, 0.1, store_every=-1)
     with pytest.raises(SceneError, match="beta"):
         steady_line(1.0, -1.0, -0.5, 2.0)
     with pytest.raises(SceneError, match="V"):

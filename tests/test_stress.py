@@ -150,7 +150,7 @@ def test_femehl_step_solves_its_weak_form():
         if prev is not None:
             # the solver stops at ||b - A p|| <= rtol ||b||; this residual is scaled by the
             # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound 100 rtol)
-            assert mass_balance_residual(st, prev, s) < 100 * st.rtol
+            assert mass_balance_residual(st, prev, s) < 100 * st.solver.rtol
         prev = s
 
 

@@ -1,0 +1,397 @@
+"""Linear solvers of the one linear system per step, with their state explicit.
+
+Every step of every method solves ``A p = b`` with
+
+    A = D + G C,        D sparse (n x n, the Poiseuille term),
+                        G = sum_i c_i F_i  sparse (n x film points: squeeze, Couette, ...),
+                        C the substrate's compliance (film points x n, dense or sparse),
+
+described by a :class:`StepOperator`.  The fixed products ``F_i C`` are formed once by
+the stepper, so a dense ``A`` costs one pass over memory and ``A z`` needs ONE dense
+product (``C z``) plus sparse work.
+
+Solvers are registered in :data:`LINEAR_SOLVERS` by name:
+
+``"lu"``
+    The paper's direct solve: a new LU of ``A`` every step (dense LAPACK, or SuperLU when
+    ``C`` is sparse), shared by the right-hand sides of the step.
+``"gmres"``
+    Minimal residual (GCR, equivalent to flexible GMRES) first over *recycled* directions
+    -- the last solutions and the last steps' search directions, kept with their ``C z``
+    -- and then over new directions ``z = LU^{-1} r`` with the single-precision LU of a
+    recent ``A`` as the preconditioner (one triangular-solve pair + one dense ``C``
+    product each).  The TRUE residual ``b - A x`` is checked before a solution is
+    accepted (sparse work, from the tracked ``C x``); otherwise the system is solved
+    directly.  The LU is refreshed by cost balancing: when the preconditioned iterations
+    of the last solve cost more than the average cost per solve since the last
+    factorization (factorization included), or when ``c_0 = a0/dt`` changed by more than
+    10 %.  ``refactor_after=n`` instead refreshes when a solve needed more than ``n``
+    preconditioned iterations.  ``rtol`` is the relative residual ``||b - A x|| / ||b||``
+    (default 1e-8: over the whole paper case that moves the films by < 4e-6 relative to a
+    direct solve, three orders below the finest discretization error).  With a sparse
+    ``C`` (Winkler, rigid) there is no dense product to save and it solves directly.
+
+All state (the factor, the recycled directions, the cost of one iteration, counters in
+:attr:`info`) lives on the solver instance; a solver serves one stepper.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import SceneError, SingularSystemError
+
+__all__ = ["StepOperator", "LINEAR_SOLVERS", "register_linear_solver", "DirectSolver",
+           "RecycledGCR", "make_linear_solver"]
+
+
+@dataclass
+class StepOperator:
+    """``A = D + sum_i c_i F_i C`` of one step.
+
+    Attributes
+    ----------
+    D : sparse matrix (n, n)
+        The part acting on the unknowns directly.
+    films : list of (coefficient, F, FC)
+        Film operators ``F`` (sparse, n x film points) with their fixed products ``F C``.
+    C : ndarray or sparse matrix (film points, n)
+        Compliance: ``d = h + C p`` on the film points.
+    key : float
+        A number that changes when the matrix changes a lot (``a0/dt``): LU refresh.
+    """
+
+    D: sp.spmatrix
+    films: list
+    C: object
+    key: float
+
+    @property
+    def dense(self) -> bool:
+        return isinstance(self.C, np.ndarray)
+
+    def G(self):
+        """``sum_i c_i F_i`` (sparse, n x film points)."""
+        G = None
+        for c, F, _ in self.films:
+            G = F * c if G is None else G + F * c
+        if G is None:
+            G = sp.csr_matrix((self.D.shape[0], self.C.shape[0]))
+        return G.tocsr()
+
+    def matrix(self, dtype=np.float64):
+        """The whole ``A``: dense, formed in place (row blocks, C-ordered), or sparse CSC."""
+        if not self.dense:
+            A = self.D
+            for c, _, FC in self.films:
+                A = A + c * FC
+            return sp.csc_matrix(A)
+        n = self.D.shape[0]
+        A = np.empty((n, n), dtype=dtype)
+        blk = max(1, (1 << 21) // max(n, 1))
+        for s in range(0, n, blk):
+            e = min(s + blk, n)
+            rows = None
+            for c, _, FC in self.films:
+                rows = c * FC[s:e] if rows is None else rows + c * FC[s:e]
+            A[s:e] = 0.0 if rows is None else rows
+        Dc = self.D.tocoo()
+        np.add.at(A, (Dc.row, Dc.col), Dc.data.astype(dtype))
+        return A
+
+    def apply(self, Z, CZ, G=None):
+        """``A Z`` for columns ``Z`` whose ``C Z`` is known: sparse work only."""
+        G = self.G() if G is None else G
+        return self.D @ Z + G @ CZ
+
+
+#: name -> linear solver class
+LINEAR_SOLVERS: dict[str, type] = {}
+
+
+def register_linear_solver(name: str):
+    """Class decorator adding a linear solver to :data:`LINEAR_SOLVERS`."""
+    def deco(cls):
+        cls.name = name
+        LINEAR_SOLVERS[name] = cls
+        return cls
+    return deco
+
+
+def make_linear_solver(name, **options):
+    if not isinstance(name, str) or name not in LINEAR_SOLVERS:
+        raise SceneError(f"linear_solver must be one of {sorted(LINEAR_SOLVERS)}, got {name!r}.")
+    return LINEAR_SOLVERS[name](**options)
+
+
+def _singular(t, what):
+    return SingularSystemError(f"step at t = {t:.6g}: {what}. Try a smaller dt or a finer "
+                               "discretization.", t=t)
+
+
+def _dense_lu(A, t):
+    try:
+        # A is C-ordered, so A.T is Fortran-ordered: LAPACK factors it in place (LU of A^T)
+        lu = sla.lu_factor(A.T, overwrite_a=True, check_finite=True)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise _singular(t, f"cannot factor the system ({exc})") from None
+    if np.any(np.abs(np.diag(lu[0])) == 0.0):
+        raise _singular(t, "the linear system is singular (zero pivot)")
+    return lu
+
+
+def _sparse_lu(A, t):
+    try:
+        return spla.splu(A)
+    except RuntimeError as exc:
+        raise _singular(t, f"the sparse system is singular ({exc})") from None
+
+
+@register_linear_solver("lu")
+class DirectSolver:
+    """A new LU of ``A`` every step (the paper's direct solve), shared by its right-hand sides."""
+
+    def __init__(self):
+        self.info = {"factorizations": 0, "factor_s": 0.0}
+        self.residuals: list = []       # relative true residuals of the last step (where cheap)
+
+    def factor(self, op: StepOperator, t: float):
+        t0 = time.perf_counter()
+        if op.dense:
+            lu = _dense_lu(op.matrix(), t)
+
+            def solve(b):
+                return sla.lu_solve(lu, b, trans=1)
+        else:
+            A = op.matrix()
+            lu = _sparse_lu(A, t)
+
+            def solve(b):             # sparse: the true residual costs nothing, record it
+                x = lu.solve(b)
+                self.residuals.append(float(np.linalg.norm(A @ x - b) / np.linalg.norm(b)))
+                return x
+        self.info["factorizations"] += 1
+        self.info["factor_s"] += time.perf_counter() - t0
+        return solve
+
+    def solve(self, op: StepOperator, rhs: list, t: float) -> list:
+        """``[(x, C x or None), ...]`` for each right-hand side."""
+        solve = None
+        out = []
+        self.residuals = []
+        for b in rhs:
+            if not np.any(b):
+                out.append((np.zeros_like(b), None))
+                continue
+            solve = self.factor(op, t) if solve is None else solve
+            out.append((solve(b), None))
+        return out
+
+
+@dataclass
+class _Factor:
+    lu: tuple           # LAPACK LU of A^T (A C-ordered = A^T Fortran-ordered: no copy)
+    key: float          # op.key of the factorized matrix
+    total: float        # cost of this factor's cycle: factorization + preconditioned iterations
+    solves: int = 0     # solves of this cycle
+    stale: bool = False # refresh at the next solve
+
+
+@register_linear_solver("gmres")
+class RecycledGCR:
+    """Recycled, LU-preconditioned minimal residual (see the module docstring).
+
+    Parameters
+    ----------
+    rtol : float, default: 1e-8
+        Relative residual every system is solved to, in (0, 1e-2).
+    refactor_after : int, optional
+        Refresh the LU when a solve needed more than this many preconditioned iterations;
+        default (None): by cost balancing.
+    recycle : int, default: 8
+        Recycled directions kept between solves (0: none).
+    max_krylov : int, default: 30
+        Preconditioned iterations before falling back to a direct solve.
+    """
+
+    def __init__(self, rtol: float = 1e-8, refactor_after: int | None = None, recycle: int = 8,
+                 max_krylov: int = 30):
+        try:
+            rtol = float(rtol)
+        except (TypeError, ValueError):
+            rtol = float("nan")
+        if not (0.0 < rtol < 1e-2):
+            raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
+        if refactor_after is not None and (isinstance(refactor_after, bool)
+                                           or not isinstance(refactor_after, int) or refactor_after < 1):
+            raise SceneError(f"refactor_after must be an integer >= 1 or None, got {refactor_after!r}.")
+        if isinstance(recycle, bool) or not isinstance(recycle, int) or recycle < 0:
+            raise SceneError(f"recycle must be an integer >= 0, got {recycle!r}.")
+        self.rtol = rtol
+        self.refactor_after = refactor_after
+        self.recycle = recycle
+        self.max_krylov = max_krylov
+        self.precond_dtype = np.float32     # the LU is a preconditioner only: single precision
+        self.direct = DirectSolver()
+        self.factor: _Factor | None = None
+        self.solutions: list = []           # recent (x, C x)
+        self.directions: list = []          # recent preconditioned (z, C z)
+        self.t_iter = 0.0                   # wall time of one preconditioned iteration (s)
+        self.history: list = []             # relative residuals of the last solve
+        self.info = {"factorizations": 0, "factor_s": 0.0, "krylov_iterations": 0, "krylov_s": 0.0}
+        self._own_factorizations = 0        # preconditioner LUs (the direct fallback counts its own)
+        self._own_factor_s = 0.0
+
+    def solve(self, op: StepOperator, rhs: list, t: float) -> list:
+        self.residuals = []
+        if not op.dense:                      # nothing dense to save: solve directly
+            out = self.direct.solve(op, rhs, t)
+            self.residuals = self.direct.residuals
+            self._sync()
+            return out
+        G = op.G()
+        return [self._solve_one(op, G, b, t) for b in rhs]
+
+    def _sync(self):
+        self.info["factorizations"] = self._own_factorizations + self.direct.info["factorizations"]
+        self.info["factor_s"] = self._own_factor_s + self.direct.info["factor_s"]
+
+    def _solve_one(self, op, G, b, t):
+        bnorm = float(np.linalg.norm(b))
+        if bnorm == 0.0:
+            return np.zeros_like(b), None
+        f = self.factor
+        fresh = f is None or f.stale or abs(f.key - op.key) > 0.1 * op.key
+        if fresh:
+            f = self._refactor(op, t)
+        t0 = time.perf_counter()
+        x, Cx, its, dirs = self._krylov(op, G, b, bnorm, f)
+        self.info["krylov_iterations"] += its
+        self.info["krylov_s"] += time.perf_counter() - t0
+        if x is None:
+            if fresh:        # even a fresh preconditioner failed: solve directly in double
+                x = self.direct.solve(op, [b], t)[0][0]
+                self._sync()
+                return x, None
+            f.stale = True
+            return self._solve_one(op, G, b, t)
+        self._remember(x, Cx, dirs)
+        if self.refactor_after is not None:
+            f.stale = its > self.refactor_after
+        else:
+            marginal = its * self.t_iter
+            f.total += marginal
+            f.solves += 1
+            f.stale = marginal > f.total / f.solves
+        return x, Cx
+
+    def _refactor(self, op, t):
+        """Single-precision LU of the current A, the preconditioner (in place)."""
+        self.factor = None                  # free the old factor before forming the new A
+        t0 = time.perf_counter()
+        lu = _dense_lu(op.matrix(dtype=self.precond_dtype), t)
+        cost = time.perf_counter() - t0
+        self._own_factorizations += 1
+        self._own_factor_s += cost
+        self._sync()
+        self.factor = _Factor(lu, op.key, total=cost)
+        return self.factor
+
+    def _precondition(self, r):
+        lu = self.factor.lu
+        return sla.lu_solve(lu, r.astype(lu[0].dtype, copy=False), trans=1,
+                            check_finite=False).astype(np.float64, copy=False)
+
+    def _krylov(self, op, G, b, bnorm, f):
+        """Minimal residual over recycled + preconditioned directions.
+
+        Returns ``(x, C x, preconditioned iterations, new directions)``, or ``x = None``
+        when ``rtol`` was not reached in ``max_krylov`` iterations.
+        """
+        C, D = op.C, op.D
+        tol = self.rtol * bnorm
+        rec = self.solutions + self.directions
+        m = len(rec) + self.max_krylov
+        n, ne = b.size, C.shape[0]
+        Z = np.empty((m, n))            # row j: direction z_j
+        CZ = np.empty((m, ne))          # row j: C z_j
+        Q = np.empty((m, n))            # row j: orthonormal basis of A span(Z)
+        R = np.zeros((m, m))
+        g = np.zeros(m)
+        k = 0
+        r = b.copy()
+        if rec:
+            Zr = np.array([z for z, _ in rec])
+            CZr = np.array([cz for _, cz in rec])
+            AZ = op.apply(Zr.T, CZr.T, G)                      # sparse work only
+            scale = np.linalg.norm(AZ, axis=0)
+            scale[scale == 0.0] = 1.0
+            q, rr, piv = sla.qr(AZ / scale, mode="economic", pivoting=True)
+            dg = np.abs(np.diag(rr))
+            k = int(np.count_nonzero(dg > 1e-8 * dg[0])) if dg.size and dg[0] > 0 else 0
+            sel = piv[:k]
+            Z[:k] = Zr[sel] / scale[sel, None]
+            CZ[:k] = CZr[sel] / scale[sel, None]
+            Q[:k] = q[:, :k].T
+            R[:k, :k] = rr[:k, :k]
+            for _ in range(2):                      # r = b - Q Q^T b, reorthogonalized
+                h = Q[:k] @ r
+                r -= h @ Q[:k]
+                g[:k] += h
+        its = 0
+        k_rec = k
+        hist = [float(np.linalg.norm(r)) / bnorm]
+        while True:
+            if hist[-1] <= 0.5 * self.rtol or its >= self.max_krylov:
+                if k == 0:
+                    return None, None, its, []
+                y = sla.solve_triangular(R[:k, :k], g[:k])
+                x = y @ Z[:k]
+                Cx = C @ x                                      # exact, for the state and the check
+                rt = b - D @ x - G @ Cx                         # the TRUE residual
+                res = float(np.linalg.norm(rt))
+                hist.append(res / bnorm)
+                self.history = hist
+                if np.isfinite(res) and res <= tol:
+                    self.residuals.append(res / bnorm)
+                    return x, Cx, its, [(Z[j].copy(), CZ[j].copy()) for j in range(k_rec, k)]
+                if its >= self.max_krylov or not np.isfinite(res):
+                    return None, None, its, []
+                r = rt - (Q[:k] @ rt) @ Q[:k]          # continue from the true residual
+            t0 = time.perf_counter()
+            z = self._precondition(r)
+            cz = C @ z                                          # the one dense product
+            q = D @ z + G @ cz
+            h = np.zeros(k)
+            for _ in range(2):
+                hh = Q[:k] @ q
+                q -= hh @ Q[:k]
+                h += hh
+            nq = float(np.linalg.norm(q))
+            its += 1
+            if not np.isfinite(nq) or nq == 0.0:
+                return None, None, its, []
+            Q[k] = q / nq
+            R[:k, k] = h
+            R[k, k] = nq
+            Z[k] = z
+            CZ[k] = cz
+            g[k] = Q[k] @ r
+            r -= g[k] * Q[k]
+            k += 1
+            hist.append(float(np.linalg.norm(r)) / bnorm)
+            self.t_iter = time.perf_counter() - t0
+
+    def _remember(self, x, Cx, dirs):
+        """Keep the newest solutions and preconditioned directions (with C z) for recycling."""
+        if self.recycle <= 0:
+            return
+        nsol = min(4, self.recycle)
+        self.solutions = ([(x, Cx)] + self.solutions)[:nsol]
+        self.directions = (dirs + self.directions)[:max(0, self.recycle - len(self.solutions))]

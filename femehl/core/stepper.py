@@ -1,0 +1,220 @@
+"""The one stepper: a scene's lagged Reynolds step, assembled from terms, for any method.
+
+Per step (the paper's section 3: every nonlinear coefficient lagged, so ONE linear system)
+
+    sum_terms [ matrix p + c_term F_term d^{k+1} ] = sum_terms rhs,    d^{k+1} = h^{k+1} + C p,
+
+that is ``A p = b`` with ``A = D + G C``, ``G = sum c_term F_term`` and
+``b = rhs - G h^{k+1}`` (see :mod:`femehl.core.terms`).  The discretization supplies the
+operators, the substrate its compliance ``C`` (``w = -C p`` on the film points, see
+:mod:`femehl.substrates`), the linear solver (:mod:`femehl.core.linsolve`) solves.
+
+Imposed load ``F(t)`` instead of an imposed gap: ``hc^{k+1}`` is one more unknown.  The
+right-hand side is affine in hc (``h = hc + s``), so with ``A x1 = b(h = s)`` and
+``A x2 = G 1`` the bordered system ``A p + hc G 1 = b(s)``, ``g . p = F`` gives
+``hc = (g . x1 - F) / (g . x2)`` and ``p = x1 - hc x2``: one operator, two right-hand
+sides, still one linear system per step.  This is the only place it is written.
+
+After the solve the film is checked everywhere the discretization can tell: on its film
+points, at the origin (exact compliance row) and at the nodes where a cheap estimate of
+the nodal film is thin (exact compliance rows there).  A film <= 0 anywhere raises
+:class:`~femehl.errors.FilmRuptureError` from :func:`femehl.stepping.march`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import SceneError, SingularSystemError
+from ..stepping import State, get_scheme
+from .linsolve import StepOperator, make_linear_solver
+from .terms import StepContext, terms_for
+
+__all__ = ["LaggedStepper"]
+
+_PROBE_FRACTION = 0.5     # nodes whose estimated film is below this x the film minimum are checked exactly
+_MAX_PROBES = 64
+
+
+def _nbytes(a) -> int:
+    if isinstance(a, np.ndarray):
+        return a.nbytes
+    if sp.issparse(a):
+        a = a.tocsr()
+        return a.data.nbytes + a.indices.nbytes + a.indptr.nbytes
+    return 0
+
+
+class LaggedStepper:
+    """Advance a discretized scene by one lagged linear step.
+
+    Parameters
+    ----------
+    disc : Discretization
+        Built from the scene (see :mod:`femehl.discretizations`).
+    scheme : {"euler", "bdf2"}, default: "euler"
+        "euler" is the paper's first-order scheme; "bdf2" is second order, still one
+        linear system per step (:data:`femehl.stepping.SCHEMES`).
+    linear_solver : str, optional
+        A key of :data:`femehl.core.linsolve.LINEAR_SOLVERS`; default: the
+        discretization's (``"gmres"`` for FE disks, ``"lu"`` for the FD reference and
+        line contact).
+    terms : sequence of Term, optional
+        Extra physics terms added to the registered ones.
+    **solver_options
+        Options of the linear solver (``rtol``, ``refactor_after``, ``recycle``).
+    """
+
+    def __init__(self, disc, scheme: str = "euler", linear_solver: str | None = None, terms=(),
+                 **solver_options):
+        t0 = time.perf_counter()
+        scene = disc.scene
+        self.scene = scene
+        self.disc = disc
+        self.method = disc.method
+        self.scheme = get_scheme(scheme)
+        self.beta = scene.fluid.beta
+        self.terms = terms_for(scene, None, terms)
+        for term in self.terms:
+            term.setup(disc)
+        name = disc.default_linear_solver if linear_solver is None else linear_solver
+        if not isinstance(name, str):
+            raise SceneError(f"linear_solver must be a name such as 'gmres' or 'lu', got {name!r}.")
+        if name == "lu" and solver_options:
+            raise SceneError(f"linear_solver='lu' takes no options, got {sorted(solver_options)}.")
+        self.solver = make_linear_solver(name, **solver_options)
+        substrate = scene.substrate
+        t1 = time.perf_counter()
+        self.C = substrate.compliance_operator(disc)
+        self.dense = isinstance(self.C, np.ndarray)
+        t2 = time.perf_counter()
+        self.origin = np.zeros((1, 2))
+        self.centre_row = substrate.deflection_rows(disc, self.origin)
+        self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
+        self.shape = disc.shape
+        self.g = disc.load_weights
+        self._FC: dict[str, object] = {}
+        self.info = dict(disc.info)
+        self.info.update({
+            "method": self.method, "scheme": self.scheme.name, "substrate": type(substrate).__name__,
+            "linear_solver": name, "terms": [t.name for t in self.terms],
+            "elastic_build_s": t2 - t1, "operator_bytes": int(_nbytes(self.C)),
+            "couette_assembled": False, "factorizations": 0, "krylov_iterations": 0,
+        })
+        for term in self.terms:       # the film products every step needs are formed once
+            if term.name == "squeeze":
+                self._film_product(term)
+        self.info["setup_s"] = disc.info.get("setup_s", 0.0) + time.perf_counter() - t0
+
+    # ---- operators ----------------------------------------------------------------------
+    def _film_product(self, term):
+        """``F C`` of a term, formed the first time it is needed (per term name)."""
+        FC = self._FC.get(term.name)
+        if FC is None:
+            F = term.film_operator()
+            FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
+            self._FC[term.name] = FC
+            self.info["operator_bytes"] += _nbytes(FC)
+            if term.name == "couette":
+                self.info["couette_assembled"] = True
+        return FC
+
+    def operator(self, ctx: StepContext):
+        """The step's :class:`StepOperator` and its right-hand side without the ``-G h`` part."""
+        D = None
+        films = []
+        rhs = np.zeros(self.disc.n)
+        for term in self.terms:
+            c = term.contribute(ctx)
+            if c.matrix is not None:
+                D = c.matrix if D is None else D + c.matrix
+            if c.film_coefficient != 0.0:
+                films.append((c.film_coefficient, term.film_operator(), self._film_product(term)))
+            if c.rhs is not None:
+                rhs += c.rhs
+        if D is None:
+            D = sp.csr_matrix((self.disc.n, self.disc.n))
+        return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
+
+    # ---- states -------------------------------------------------------------------------
+    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None) -> State:
+        disc = self.disc
+        if Cp is None:
+            Cp = np.asarray(self.C @ p).ravel()
+        w = -Cp
+        d = hc + self.shape + Cp
+        p_full = disc.expand(p)
+        i_min = int(np.argmin(d))
+        i_max = int(np.argmax(p_full))
+        info = dict(info or {})
+        info.update(self._probe(hc, p, Cp, float(d[i_min])))
+        return State(step=step, t=t, hc=hc, V=V, p=p_full, w=w, d=d, load=float(self.g @ p),
+                     film_center=hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0]), film_min=float(d[i_min]),
+                     film_min_at=tuple(float(v) for v in disc.film_points[i_min]),
+                     p_max=float(p_full[i_max]), p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
+                     info=info, d_prev=d_prev, dt_prev=dt_prev)
+
+    def _probe(self, hc, p, Cp, d_min):
+        """The film at the nodes whose estimated film is thin, computed exactly."""
+        avg = self.disc.node_average
+        if avg is None:
+            return {}
+        est = hc + self.disc.node_shape + avg @ Cp
+        thin = np.flatnonzero(est < _PROBE_FRACTION * d_min)
+        if thin.size == 0:
+            return {}
+        thin = thin[np.argsort(est[thin])[:_MAX_PROBES]]
+        pts = self.disc.nodes[thin]
+        rows = self.scene.substrate.deflection_rows(self.disc, pts)
+        exact = hc + self.disc.node_shape[thin] + np.asarray(rows @ p).ravel()
+        j = int(np.argmin(exact))
+        return {"node_film_min": float(exact[j]), "node_film_min_at": tuple(float(v) for v in pts[j])}
+
+    def initial_state(self) -> State:
+        mo = self.scene.motion
+        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n))
+
+    # ---- one step -----------------------------------------------------------------------
+    def step(self, state: State, t_new: float, dt: float) -> State:
+        """One lagged step: ONE linear system (bordered by one row under imposed load)."""
+        mo = self.scene.motion
+        V = mo.V(t_new)
+        omega = None if state.d_prev is None or not state.dt_prev else dt / state.dt_prev
+        a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
+        if l1 == 0.0:
+            d_lag, hist = state.d, state.d
+        else:       # extrapolated coefficient, kept positive
+            d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
+            hist = a1 * state.d - a2 * state.d_prev
+        p_old = state.p[self.disc.free_index]
+        its0 = self.solver.info.get("krylov_iterations", 0)
+        ctx = StepContext(t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old,
+                          V=V, beta=self.beta)
+        op, rhs = self.operator(ctx)
+        G = op.G()
+        if mo.load_controlled:
+            F = mo.F(t_new)
+            ones = np.ones(self.shape.size)
+            (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ self.shape, G @ ones], t_new)
+            den = float(self.g @ x2)
+            if not np.isfinite(den) or den == 0.0:
+                raise SingularSystemError(f"step at t = {t_new:.6g}: the load row is singular "
+                                          "(the film does not respond to hc).", t=t_new)
+            hc = (float(self.g @ x1) - F) / den
+            p = x1 - hc * x2
+            Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
+        else:
+            hc = mo.hc(t_new)
+            ((p, Cp),) = self.solver.solve(op, [rhs - G @ (hc + self.shape)], t_new)
+        if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
+                "or ill-conditioned. Try a smaller dt or a finer discretization.", t=t_new)
+        self.info.update(self.solver.info)
+        info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
+        if self.solver.residuals:
+            info["residual"] = max(self.solver.residuals)
+        return self._state(state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info)

@@ -1,0 +1,227 @@
+"""Finite elements on a triangulated disk: P1 pressure, P0 film (scikit-fem).
+
+The weak form of the Reynolds equation (see :mod:`femehl.fe.forms`): find p in P1,
+p = 0 on r = L, such that for every P1 test function q
+
+    beta int m grad p . grad q  +  V int d dq/dx  +  int (dd/dt) q  = 0,
+
+with the film ``d`` and the mobility ``m`` constant on elements (their values at the
+centroids).  So ``poiseuille`` is the stiffness matrix with element coefficient m,
+``couette`` is ``Bx[q, e] = int_e dq/dx`` and ``squeeze`` is ``M[q, e] = int_e q``.
+The elastic half space is the exact Boussinesq integral of the element-average pressure
+over every triangle, at the centroids (:func:`femehl.kernels.edge_terms`: one exact term
+per unique edge), mirrored for a half disk.  A half disk (y >= 0) is used for scenes
+symmetric in y; its load is doubled.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, ElementTriP0, ElementTriP1, asm
+
+from ..errors import SceneError
+from ..fe.forms import couette, film_diffusion, squeeze
+from ..fe.mesh import areas, centroids, load_mesh
+from ..kernels import edge_terms, mesh_edges, triangle_influence
+from . import register_method
+
+__all__ = ["FEDisc"]
+
+
+def _looks_like_path(s: str) -> bool:
+    return any(ch in s for ch in "/\\.")
+
+
+@register_method("fe")
+class FEDisc:
+    """A disk mesh with P1 pressure and element-constant film.
+
+    Parameters
+    ----------
+    scene : femehl.Scene
+    mesh : str, path, skfem.MeshTri or DiskMesh, default: "medium"
+        A ladder name ("coarse", "medium", "fine", "xfine") or any mesh meshio reads.
+    half : bool, optional
+        Use the half disk y >= 0; default: True when the indenter is symmetric in y.
+    """
+
+    default_linear_solver = "gmres"
+
+    def __init__(self, scene, mesh="medium", half: bool | None = None):
+        t0 = time.perf_counter()
+        self.scene = scene
+        symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
+        if half is not None and not isinstance(half, (bool, np.bool_)):
+            raise SceneError(f"half must be True, False or None (automatic), got {half!r}.")
+        if half is None:
+            half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
+        if half and not symmetric:
+            raise SceneError("a half-disk mesh needs an indenter symmetric in y; use half=False "
+                             "or a full-disk mesh.")
+        dm = load_mesh(mesh, L=scene.domain.L, half=half)
+        if dm.half and not symmetric:
+            raise SceneError(f"mesh {dm.name!r} is a half disk but the indenter is not symmetric "
+                             "in y: use a full-disk mesh.")
+        self.dm = dm
+        self.mesh = dm.mesh
+        self.half = dm.half
+        self.L = dm.L
+        self.basis = b1 = Basis(self.mesh, ElementTriP1())
+        self.basis0 = b0 = b1.with_element(ElementTriP0())
+        p, t = self.mesh.p, self.mesh.t
+        self.nodes = p.T.copy()
+        self.tri = np.transpose(p[:, t], (2, 1, 0))            # (ne, 3, 2)
+        self.centroids = centroids(dm)
+        self.film_points = self.centroids
+        self.areas = areas(dm)
+        ne, nn = t.shape[1], p.shape[1]
+        # element average of a P1 field: (P p)_e = mean of its 3 nodal values
+        self.P = sp.csr_matrix((np.full(3 * ne, 1.0 / 3.0),
+                                (np.repeat(np.arange(ne), 3), t.T.ravel())), shape=(ne, nn))
+        r = np.hypot(p[0], p[1])
+        self.free = np.flatnonzero(r < self.L * (1.0 - 1e-9))
+        self.free_index = self.free
+        self.n = int(self.free.size)
+        self.shape = self.gap(self.centroids)
+        self.node_shape = self.gap(self.nodes)
+        # nodal estimate of a film-point field: mean over the elements around each node
+        inc = sp.csr_matrix((np.ones(3 * ne), (t.T.ravel(), np.repeat(np.arange(ne), 3))), shape=(nn, ne))
+        self.node_average = sp.diags(1.0 / np.asarray(inc.sum(axis=1)).ravel()) @ inc
+        # element stiffness with unit coefficient; K(m) scales each element by m
+        kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(ne)))
+        self._k_rows, self._k_cols = kcoo.indices
+        self._k_data = kcoo.data.reshape(-1, ne)                   # (9, ne), element last
+        Mfull = asm(squeeze, b0, b1).tocsr()
+        self._M = Mfull[self.free]
+        mult = 2.0 if self.half else 1.0
+        self.node_weight = np.asarray(Mfull.sum(axis=1)).ravel()   # int phi_q dA
+        self.load_weights = mult * self.node_weight[self.free]
+        self._finder_ = None
+        self.info = {"mesh": dm.name, "half": dm.half, "elements": ne, "nodes": nn,
+                     "unknowns": self.n, "setup_s": time.perf_counter() - t0}
+
+    # ---- geometry ------------------------------------------------------------------------
+    @property
+    def nelements(self) -> int:
+        return self.mesh.t.shape[1]
+
+    @property
+    def nnodes(self) -> int:
+        return self.mesh.p.shape[1]
+
+    def gap(self, points):
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        s = np.asarray(self.scene.indenter.gap(pts[:, 0], pts[:, 1]), dtype=float)
+        if s.shape != (pts.shape[0],) or not np.all(np.isfinite(s)):
+            raise SceneError("the indenter's gap(x, y) must return finite values of the same shape "
+                             "as x; check the shape function.")
+        return s
+
+    def expand(self, p_free):
+        p = np.zeros(self.nnodes)
+        p[self.free] = p_free
+        return p
+
+    # ---- Reynolds operators ------------------------------------------------------------
+    def poiseuille(self, d, m, dm_dd=None):
+        """``K(m)[q, p] = int m grad p . grad q`` on the free nodes, m on elements."""
+        data = (self._k_data * m[None, :]).ravel()
+        n = self.nnodes
+        K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
+        return K[self.free][:, self.free]
+
+    def couette(self):
+        """``Bx[q, e] = int_e dq/dx`` (free nodes x elements)."""
+        return asm(couette, self.basis0, self.basis).tocsr()[self.free]
+
+    def squeeze(self):
+        """``M[q, e] = int_e q`` (free nodes x elements)."""
+        return self._M
+
+    # ---- substrate primitives ------------------------------------------------------------
+    def average(self):
+        return self.P[:, self.free]
+
+    def _locate(self, points):
+        if self._finder_ is None:
+            import matplotlib.tri as mtri
+            self._tri = mtri.Triangulation(self.mesh.p[0], self.mesh.p[1], self.mesh.t.T)
+            self._finder_ = self._tri.get_trifinder()
+        pts = np.asarray(points, dtype=float).reshape(-1, 2).copy()
+        if self.half:
+            pts[:, 1] = np.abs(pts[:, 1])
+        return pts, self._finder_(pts[:, 0], pts[:, 1])
+
+    def pressure_rows(self, points):
+        """Sparse rows of the P1 interpolation at ``points`` (0 outside the mesh)."""
+        pts, e = self._locate(points)
+        ok = np.flatnonzero(e >= 0)
+        nodes = self.mesh.t[:, e[ok]].T                       # (k, 3)
+        X = self.nodes[nodes]                                 # (k, 3, 2)
+        T = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=-1)   # (k, 2, 2)
+        lam = np.linalg.solve(T, (pts[ok] - X[:, 0])[..., None])[..., 0] if ok.size else np.zeros((0, 2))
+        bary = np.column_stack([1.0 - lam.sum(axis=1), lam])
+        rows, cols, vals = np.repeat(ok, 3), nodes.ravel(), bary.ravel()
+        R = sp.csr_matrix((vals, (rows, cols)), shape=(pts.shape[0], self.nnodes))
+        return R[:, self.free]
+
+    def boussinesq(self):
+        """Dense ``X P[:, free]``: exact ``int_T dA'/|c_i - x'|`` of the element averages.
+
+        X is never stored: with the signed edge incidence S of :func:`mesh_edges`, X = T S
+        where T holds one exact term per unique edge, so a block of rows is T_block (S P).
+        For a half disk the mirror images (orientation reversed) add -T_mirror S.
+        """
+        ne = self.nelements
+        edges, S = mesh_edges(self.mesh.t, self.nodes)
+        SP = (S @ self.P[:, self.free]).tocsc()             # (nedges, nfree), sparse
+        mirror = self.nodes * np.array([1.0, -1.0])
+        C = np.empty((ne, self.n))
+        block = max(1, int(2**26 // (8 * edges.shape[0])))
+        for s in range(0, ne, block):
+            e = slice(s, min(s + block, ne))
+            T = edge_terms(self.centroids[e], self.nodes, edges)
+            if self.half:
+                T -= edge_terms(self.centroids[e], mirror, edges)
+            C[e] = (SP.T @ T.T).T
+        return C
+
+    def boussinesq_rows(self, points):
+        """Rows of :meth:`boussinesq` at arbitrary points (mirror image included)."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        X = triangle_influence(pts, self.tri)
+        if self.half:
+            X += triangle_influence(pts, self.tri * np.array([1.0, -1.0]))
+        return np.asarray(self.P[:, self.free].T @ X.T).T
+
+    # ---- fields for results and writers -----------------------------------------------
+    def pressure_at(self, p, points):
+        """P1 interpolation; 0 outside the mesh (p = 0 beyond r = L)."""
+        return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()
+
+    def _cell_value(self, values, points):
+        pts, e = self._locate(points)
+        out = np.full(pts.shape[0], np.nan)
+        ok = e >= 0
+        out[ok] = np.asarray(values)[e[ok]]
+        return out
+
+    def film_at(self, d, points):
+        """Element-constant film thickness (NaN outside the mesh)."""
+        return self._cell_value(d, points)
+
+    def deflection_at(self, w, points):
+        return self._cell_value(w, points)
+
+    def vtk_geometry(self):
+        """Points (z = 0), triangles, and False: film fields live on elements."""
+        p = self.mesh.p
+        pts = np.column_stack([p[0], p[1], np.zeros(p.shape[1])])
+        return pts, [("triangle", self.mesh.t.T.astype(np.int64))], False
+
+    def centreline(self, n: int = 401):
+        x = np.linspace(-self.L, self.L, n)
+        return np.column_stack([x, np.zeros_like(x)])

@@ -1,0 +1,27 @@
+"""Substrates: each one owns its elastic operator for any discretization.
+
+Convention: the surface deflection is ``w = -C p`` on the discretization's film points
+(``w < 0`` under positive pressure, so the film is ``d = h - w = h + C p``).  A substrate
+is a frozen dataclass with two methods, written against the primitives every
+discretization offers (:mod:`femehl.discretizations`):
+
+``compliance_operator(disc)``
+    ``C`` (film points x pressure unknowns): a dense ndarray for a non-local substrate,
+    a scipy sparse matrix for a local one (then no dense matrix is built anywhere).
+``deflection_rows(disc, points)``
+    The rows of ``C`` at arbitrary points (the origin for the central film, nodes for
+    the film check).
+
+The primitives are ``disc.boussinesq()`` / ``disc.boussinesq_rows(points)`` (exact
+integral of ``1/|x - x'|`` of the discretized unit pressure, mirror image included for a
+half domain), ``disc.average()`` (the pressure's value on the film points) and
+``disc.pressure_rows(points)``.  A new substrate is one module defining such a class; no
+solver file changes.
+"""
+
+from .base import Substrate
+from .halfspace import HalfSpace
+from .rigid import Rigid
+from .winkler import Winkler
+
+__all__ = ["Substrate", "HalfSpace", "Winkler", "Rigid"]

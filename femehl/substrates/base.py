@@ -1,0 +1,20 @@
+"""The substrate protocol (see :mod:`femehl.substrates`)."""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+__all__ = ["Substrate"]
+
+
+@runtime_checkable
+class Substrate(Protocol):
+    """What the stepper needs from a substrate: ``w = -C p`` on film points and elsewhere."""
+
+    kind: str
+
+    def compliance_operator(self, disc):
+        """``C`` with ``w = -C p`` on ``disc.film_points`` (dense ndarray or sparse)."""
+
+    def deflection_rows(self, disc, points):
+        """Rows of ``C`` at ``points`` (n, 2): ``w(points) = -rows @ p``."""

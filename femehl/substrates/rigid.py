@@ -1,0 +1,23 @@
+"""Rigid substrate: ``w = 0``; the step is the rigid Reynolds problem."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["Rigid"]
+
+
+@dataclass(frozen=True)
+class Rigid:
+    """Rigid substrate: w = 0, no elastic operator at all."""
+
+    kind = "rigid"
+
+    def compliance_operator(self, disc):
+        return sp.csr_matrix((disc.film_points.shape[0], disc.n))
+
+    def deflection_rows(self, disc, points):
+        return sp.csr_matrix((np.asarray(points).reshape(-1, 2).shape[0], disc.n))

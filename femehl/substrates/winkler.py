@@ -1,0 +1,26 @@
+"""Winkler foundation: ``w = -p / k``, local (every operator sparse)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..validation import check_positive
+
+__all__ = ["Winkler"]
+
+
+@dataclass(frozen=True)
+class Winkler:
+    """Winkler foundation: ``w = -p / k`` (local, diagonal)."""
+
+    k: float = 1.0
+    kind = "winkler"
+
+    def __post_init__(self):
+        object.__setattr__(self, "k", check_positive("Winkler stiffness k", self.k))
+
+    def compliance_operator(self, disc):
+        return (disc.average() / self.k).tocsr()
+
+    def deflection_rows(self, disc, points):
+        return (disc.pressure_rows(points) / self.k).tocsr()

@@ -501,6 +501,10 @@ class Scene:
         bad = ~np.isfinite(s)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
+            if np.isinf(s[k]) and callable(getattr(self.indenter, "domain_hint", None)):
+                raise SceneError(
+                    f"{self._describe_indenter()} is too sharp for the domain r <= {L:g}: its gap "
+                    f"overflows to inf at (x, y) = ({x[k]:.3g}, {y[k]:.3g}). {self._rise_hint()}")
             cause = ("overflows to inf" if np.isinf(s[k]) else "is NaN")
             raise SceneError(
                 f"{what} {cause} at (x, y) = ({x[k]:.3g}, {y[k]:.3g}): it must return one finite value "

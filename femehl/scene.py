@@ -21,7 +21,10 @@ Eq. 2c writes h = hc - r^2/2R, a sign slip; femehl uses + as in Eq. 12.)
 
 :class:`Dimensional` converts SI inputs to a scene and back.
 Scenes are immutable; validation happens at construction and raises
-:class:`femehl.errors.SceneError` with a message that names the fix.
+:class:`femehl.errors.SceneError` with a message that names the fix (the
+validators live in :mod:`femehl.validation`; ``check_finite`` and
+``check_positive`` are re-exported here).  A time history (gap, velocity,
+load) that raises is reported as a SceneError naming the history and the time.
 """
 
 from __future__ import annotations
@@ -255,7 +258,8 @@ class Motion:
     velocity : callable or float, default: 0.0
         Sliding velocity V(t) in units of V_ss.
     load : callable or float, optional
-        Imposed load F(t) = int p dA.  Then hc(t) is solved for at every step
+        Imposed load F(t) = int p dA, >= 0 (the film cannot pull: a negative
+        load at t = 0 or any sampled time is refused).  Then hc(t) is solved for at every step
         (one more unknown, one more row: the step stays one linear system) and
         ``gap`` only gives the initial clearance hc(0).
     """
@@ -326,6 +330,7 @@ class Scene:
         if not hasattr(self.indenter, "gap"):
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
         hc0 = self.motion.hc(0.0)
+        self.motion.V(0.0)               # a velocity history that fails at t = 0 is refused now
         if hc0 <= 0.0:
             raise SceneError(
                 f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
@@ -351,8 +356,14 @@ class Scene:
         a rigid substrate is never indented under load (no check).
 
         Also checks that the indenter covers the domain (``check_domain(L)``
-        of a height map), that its gap is finite on the domain, and that the
-        initial film ``hc(0) + s`` is positive everywhere.
+        of a height map), that its gap is one finite real value per point on
+        the domain, that an analytic indenter's gap rises by ``GAP_RISE`` =
+        (1e-6, 1e6) across the domain (a radius neither so large that the
+        indenter is flat on the domain nor so small that its contact is a dot
+        or its gap overflows), that an indenter declaring ``symmetric_y`` is
+        symmetric in y on the domain, that the initial film ``hc(0) + s`` is
+        positive everywhere, and that an imposed load is >= 0 at every
+        sampled time (the lubricated model cannot pull).
         """
         L = self.domain.L
         ind = self.indenter

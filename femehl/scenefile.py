@@ -64,7 +64,7 @@ from .scene import (
     TanhStart,
     Winkler,
 )
-from .validation import check_int
+from .validation import check_finite, check_int
 
 try:
     import tomllib
@@ -246,7 +246,6 @@ def _si_scene(raw, path):
             kind = ind.pop("kind", None)
             changes["indenter"] = si_indenter(kind, ind, dim)
         if "load" in si:
-            from .scene import check_finite
             F = check_finite("[si] load [N]", si["load"]) / dim.force
             changes["motion"] = Motion(gap=Constant(scene.motion.hc(0.0)),
                                        velocity=scene.motion.velocity, load=Constant(F))

@@ -170,6 +170,7 @@ def _boom(t):
 @pytest.mark.parametrize("kw,history", [
     ({"gap": _boom}, r"the gap history hc\(t\) raised ZeroDivisionError at t = 0"),
     ({"gap": 0.1, "load": _boom}, r"the load history F\(t\) raised ZeroDivisionError at t = 0"),
+    ({"gap": 0.1, "velocity": _boom}, r"the velocity history V\(t\) raised ZeroDivisionError at t = 0"),
 ])
 def test_history_that_raises_is_refused_naming_history(kw, history):
     with pytest.raises(SceneError, match=history + r" \(bad\): fix the function"):

@@ -254,7 +254,8 @@ class Shape:
         """``func(x, y)`` checked: real, finite, same shape as the broadcast inputs."""
         x, y = _xy(x, y)
         try:
-            s = self.func(x.copy(), y.copy())
+            with np.errstate(all="ignore"):          # NaN / inf results are refused below
+                s = self.func(x.copy(), y.copy())
         except Exception as exc:  # noqa: BLE001 - the user's code: report what failed
             raise SceneError(f"Shape {self.name!r}: func(x, y) raised {type(exc).__name__}: {exc}. "
                              "It must accept numpy arrays (use np.sin, np.hypot, ...).") from None

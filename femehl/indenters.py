@@ -34,20 +34,32 @@ z)``               interpolated bilinearly; must cover the disk ``r <= L``
 from __future__ import annotations
 
 import pathlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import ClassVar
 
 import numpy as np
 
 from .errors import SceneError
+from .validation import check_positive, check_shape_values
 
-__all__ = ["Sphere", "Ellipsoid", "FlatPunch", "Shape", "HeightMap", "INDENTERS",
-           "si_indenter"]
+__all__ = [
+    "INDENTERS",
+    "Ellipsoid",
+    "FlatPunch",
+    "HeightMap",
+    "Shape",
+    "Sphere",
+    "si_indenter",
+]
 
 
-def _positive(name, value, hint=""):
-    from .scene import check_positive  # lazy: femehl.scene imports this module
-    return check_positive(name, value, hint)
+_positive = check_positive  # the historic local name
+
+
+def _radius_range(L: float, rise: tuple) -> tuple:
+    """Radii R for which L^2 / (2 R) lies in ``rise`` = (lo, hi)."""
+    return L * L / (2.0 * rise[1]), L * L / (2.0 * rise[0])
 
 
 def _xy(x, y):
@@ -74,7 +86,7 @@ class Sphere:
     symmetric_y = True
     axisymmetric = True
     #: how each parameter converts from SI (see :func:`si_indenter`)
-    si_units = {"R": "curvature"}
+    si_units: ClassVar[dict] = {"R": "curvature"}
 
     def __post_init__(self):
         object.__setattr__(self, "R", _positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization."))
@@ -84,6 +96,13 @@ class Sphere:
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         return (x * x + y * y) / (2.0 * self.R)
+
+    def domain_hint(self, L: float, rise: tuple) -> str:
+        """How to choose R so that the gap's rise L^2/(2R) on the domain r <= L lies in ``rise``."""
+        lo, hi = _radius_range(L, rise)
+        return (f"Use a radius {lo:.3g} <= R <= {hi:.3g} for the domain radius L = {L:g} "
+                f"(s(L) = L^2/(2R) must lie in [{rise[0]:g}, {rise[1]:g}]; R = 1 in the paper's "
+                "normalization), or change L.")
 
 
 @dataclass(frozen=True)
@@ -104,7 +123,7 @@ class Ellipsoid:
     Rx: float = 1.0
     Ry: float = 1.0
     symmetric_y = True
-    si_units = {"Rx": "curvature", "Ry": "curvature"}
+    si_units: ClassVar[dict] = {"Rx": "curvature", "Ry": "curvature"}
 
     def __post_init__(self):
         hint = "Give positive radii of curvature, e.g. Ellipsoid(Rx=0.5, Ry=2.0)."
@@ -121,6 +140,13 @@ class Ellipsoid:
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         return x * x / (2.0 * self.Rx) + y * y / (2.0 * self.Ry)
+
+    def domain_hint(self, L: float, rise: tuple) -> str:
+        """How to choose Rx, Ry so that the gap's rise on the domain r <= L lies in ``rise``."""
+        lo, hi = _radius_range(L, rise)
+        return (f"Use radii of curvature with {lo:.3g} <= min(Rx, Ry) and max(Rx, Ry) <= {hi:.3g} "
+                f"for the domain radius L = {L:g} (the rise L^2/(2R) must lie in "
+                f"[{rise[0]:g}, {rise[1]:g}]), or change L.")
 
 
 @dataclass(frozen=True)
@@ -143,7 +169,7 @@ class FlatPunch:
     edge_radius: float = 0.5
     symmetric_y = True
     axisymmetric = True
-    si_units = {"a": "length", "edge_radius": "curvature"}
+    si_units: ClassVar[dict] = {"a": "length", "edge_radius": "curvature"}
 
     def __post_init__(self):
         object.__setattr__(self, "a", _positive("FlatPunch radius a", self.a, "Give the radius of the flat face; "
@@ -158,6 +184,16 @@ class FlatPunch:
         y = np.asarray(y, dtype=float)
         e = np.maximum(np.hypot(x, y) - self.a, 0.0)
         return e * e / (2.0 * self.edge_radius)
+
+    def domain_hint(self, L: float, rise: tuple) -> str:
+        """How to choose a and edge_radius so that the rise (L - a)^2/(2 edge_radius) lies in ``rise``."""
+        if self.a >= L:
+            return (f"The flat face (a = {self.a:g}) covers the whole domain r <= L = {L:g}: use "
+                    f"a < L, or a domain radius L > a (the paper's rule: L about 2 contact radii).")
+        lo, hi = _radius_range(L - self.a, rise)
+        return (f"Use {lo:.3g} <= edge_radius <= {hi:.3g} for a = {self.a:g} and L = {L:g} "
+                f"(the rise (L - a)^2/(2 edge_radius) must lie in [{rise[0]:g}, {rise[1]:g}]), "
+                "or change L.")
 
 
 # --------------------------------------------------------------------------
@@ -203,28 +239,27 @@ class Shape:
         object.__setattr__(self, "symmetric_y", bool(self.symmetric_y))
         g = np.linspace(-1.0, 1.0, 5)
         X, Y = np.meshgrid(g, g, indexing="ij")
-        self.gap(X, Y)
+        s = self.gap(X, Y)
+        if self.symmetric_y:
+            s_m = self.gap(X, -Y)
+            tol = 1e-9 * max(float(np.ptp(s)), float(np.max(np.abs(s))), np.finfo(float).tiny)
+            if np.any(np.abs(s_m - s) > tol):
+                k = np.unravel_index(int(np.argmax(np.abs(s_m - s))), s.shape)
+                raise SceneError(
+                    f"Shape {self.name!r} declares symmetric_y=True, but func(x, -y) != func(x, y): "
+                    f"func({X[k]:.3g}, {Y[k]:.3g}) = {s[k]:.6g}, func({X[k]:.3g}, {-Y[k]:.3g}) = "
+                    f"{s_m[k]:.6g}. Pass symmetric_y=False (the solver then uses the full disk).")
 
     def gap(self, x, y):
-        """``func(x, y)`` checked: finite, same shape as the broadcast inputs."""
+        """``func(x, y)`` checked: real, finite, same shape as the broadcast inputs."""
         x, y = _xy(x, y)
         try:
-            s = self.func(x.copy(), y.copy())
-        except Exception as exc:  # the user's code: report what failed
+            with np.errstate(all="ignore"):          # NaN / inf results are refused below
+                s = self.func(x.copy(), y.copy())
+        except Exception as exc:  # noqa: BLE001 - the user's code: report what failed
             raise SceneError(f"Shape {self.name!r}: func(x, y) raised {type(exc).__name__}: {exc}. "
                              "It must accept numpy arrays (use np.sin, np.hypot, ...).") from None
-        try:
-            s = np.asarray(s, dtype=float)
-        except (TypeError, ValueError):
-            raise SceneError(f"Shape {self.name!r}: func(x, y) must return numbers, got "
-                             f"{type(s).__name__}.") from None
-        if s.shape != x.shape:
-            if s.ndim == 0:
-                s = np.broadcast_to(s, x.shape).copy()
-            else:
-                raise SceneError(f"Shape {self.name!r}: func(x, y) returned shape {s.shape} for "
-                                 f"inputs of shape {x.shape}: return one value per point "
-                                 "(vectorize with numpy).")
+        s = check_shape_values(f"Shape {self.name!r}: func(x, y)", s, x.shape)
         if not np.all(np.isfinite(s)):
             bad = np.flatnonzero(~np.isfinite(s.ravel()))[0]
             raise SceneError(f"Shape {self.name!r}: func(x, y) is not finite (NaN or inf) at "
@@ -316,7 +351,7 @@ class HeightMap:
                 f"z=[{self.z.min():g} .. {self.z.max():g}], symmetric_y={self.symmetric_y})")
 
     @classmethod
-    def from_file(cls, path, symmetric_y: bool | None = None) -> "HeightMap":
+    def from_file(cls, path, symmetric_y: bool | None = None) -> HeightMap:
         """Read a map from an ``.npz`` file holding arrays ``x``, ``y`` and ``z``."""
         path = pathlib.Path(path)
         try:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, check_positive
+from .scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart
+from .validation import check_positive
 
 __all__ = ["paper_sphere"]
 

@@ -21,15 +21,19 @@ Eq. 2c writes h = hc - r^2/2R, a sign slip; femehl uses + as in Eq. 12.)
 
 :class:`Dimensional` converts SI inputs to a scene and back.
 Scenes are immutable; validation happens at construction and raises
-:class:`femehl.errors.SceneError` with a message that names the fix.
+:class:`femehl.errors.SceneError` with a message that names the fix (the
+validators live in :mod:`femehl.validation`; ``check_finite`` and
+``check_positive`` are re-exported here).  A time history (gap, velocity,
+load) that raises is reported as a SceneError naming the history and the time.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, Protocol, runtime_checkable
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -37,45 +41,27 @@ from .errors import SceneError
 from .substrates import HalfSpace, Rigid, Winkler  # noqa: F401  (re-exported)
 from .indenters import Sphere  # indenters live in femehl.indenters; Sphere stays importable here
 
+# the validators live in femehl.validation; re-exported here (other modules import them from scene)
+from .validation import _short, call_time_function, check_finite, check_positive, check_shape_values
+
 __all__ = [
-    "Sphere", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
-    "Scene", "Dimensional", "TimeFunction", "Constant", "Table", "RampHold",
-    "TanhStart", "check_positive", "check_finite",
+    "Constant",
+    "Dimensional",
+    "Domain",
+    "Fluid",
+    "HalfSpace",
+    "Motion",
+    "RampHold",
+    "Rigid",
+    "Scene",
+    "Sphere",
+    "Table",
+    "TanhStart",
+    "TimeFunction",
+    "Winkler",
+    "check_finite",
+    "check_positive",
 ]
-
-
-# --------------------------------------------------------------------------
-# validation helpers
-# --------------------------------------------------------------------------
-def _short(value) -> str:
-    r = repr(value)
-    return r if len(r) <= 40 else r[:37] + "..."
-
-
-def check_finite(name: str, value, hint: str = "") -> float:
-    """Return ``value`` as a float, or raise SceneError if it is not a finite real number.
-
-    Strings, booleans, complex numbers and other non-real types are refused
-    (a "1" in a scene is a typo, not a number).
-    """
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise SceneError(f"{name} must be a real number, got {_short(value)} "
-                         f"({type(value).__name__}). {hint}".strip())
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise SceneError(f"{name} must be a finite number, got {_short(value)}. {hint}".strip()) from None
-    if not math.isfinite(v):
-        raise SceneError(f"{name} must be finite, got {v}. {hint}".strip())
-    return v
-
-
-def check_positive(name: str, value, hint: str = "") -> float:
-    """Return ``value`` as a float, or raise SceneError if it is not finite and > 0."""
-    v = check_finite(name, value, hint)
-    if v <= 0.0:
-        raise SceneError(f"{name} must be > 0, got {v}. {hint}".strip())
-    return v
 
 
 # --------------------------------------------------------------------------
@@ -189,6 +175,12 @@ class TanhStart:
         return 0.0 if t < self.t1 else self.V_ss * math.tanh((t - self.t1) / self.T)
 
 
+#: Accepted rise max(s) - min(s) of the indenter's gap across the domain (units of h_inf).
+GAP_RISE = (1e-6, 1e6)
+#: An indenter declaring symmetric_y must satisfy |s(x, -y) - s(x, y)| <= SYMMETRY_RTOL * scale,
+#: scale = max(range of s, max |s|) on the domain (round-off of a symmetric shape passes).
+SYMMETRY_RTOL = 1e-9
+
 #: The domain must reach CONTACT_MARGIN times the geometric overlap radius a_geo of the
 #: deepest indentation: 1.5/sqrt(2) ~ 1.06, i.e. L >= 1.5 a_Hertz for a sphere.
 CONTACT_MARGIN = 1.5 / math.sqrt(2.0)
@@ -233,7 +225,8 @@ class Motion:
     velocity : callable or float, default: 0.0
         Sliding velocity V(t) in units of V_ss.
     load : callable or float, optional
-        Imposed load F(t) = int p dA.  Then hc(t) is solved for at every step
+        Imposed load F(t) = int p dA, >= 0 (the film cannot pull: a negative
+        load at t = 0 or any sampled time is refused).  Then hc(t) is solved for at every step
         (one more unknown, one more row: the step stays one linear system) and
         ``gap`` only gives the initial clearance hc(0).
     """
@@ -254,14 +247,26 @@ class Motion:
         return self.load is not None
 
     def F(self, t: float) -> float:
-        return check_finite(f"F(t={t:g})", self.load(t), "The load history must return finite values.")
+        """The imposed load F(t) (finite, >= 0: the lubricated contact cannot pull)."""
+        F = call_time_function("the load history F(t)", "F", self.load, t,
+                               "The load history must return finite values.")
+        if F < 0.0:
+            raise SceneError(_negative_load_message(F, t))
+        return F
 
     def hc(self, t: float) -> float:
-        return check_finite(f"hc(t={t:g})", self.gap(t), "The gap history must return finite values.")
+        return call_time_function("the gap history hc(t)", "hc", self.gap, t,
+                                  "The gap history must return finite values.")
 
     def V(self, t: float) -> float:
-        return check_finite(f"V(t={t:g})", self.velocity(t),
-                            "The velocity history must return finite values.")
+        return call_time_function("the velocity history V(t)", "V", self.velocity, t,
+                                  "The velocity history must return finite values.")
+
+
+def _negative_load_message(F: float, t: float) -> str:
+    return (f"the imposed load F(t={t:g}) = {F:g} is negative: the lubricated model cannot pull "
+            "the indenter (the film would be in tension, i.e. cavitate). Give a load history "
+            "with F(t) >= 0 at all times, or impose the gap hc(t) instead (Motion(gap=...)).")
 
 
 @dataclass(frozen=True)
@@ -292,6 +297,7 @@ class Scene:
         if not hasattr(self.indenter, "gap"):
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
         hc0 = self.motion.hc(0.0)
+        self.motion.V(0.0)               # a velocity history that fails at t = 0 is refused now
         if hc0 <= 0.0:
             raise SceneError(
                 f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
@@ -317,8 +323,14 @@ class Scene:
         a rigid substrate is never indented under load (no check).
 
         Also checks that the indenter covers the domain (``check_domain(L)``
-        of a height map), that its gap is finite on the domain, and that the
-        initial film ``hc(0) + s`` is positive everywhere.
+        of a height map), that its gap is one finite real value per point on
+        the domain, that an analytic indenter's gap rises by ``GAP_RISE`` =
+        (1e-6, 1e6) across the domain (a radius neither so large that the
+        indenter is flat on the domain nor so small that its contact is a dot
+        or its gap overflows), that an indenter declaring ``symmetric_y`` is
+        symmetric in y on the domain, that the initial film ``hc(0) + s`` is
+        positive everywhere, and that an imposed load is >= 0 at every
+        sampled time (the lubricated model cannot pull).
         """
         L = self.domain.L
         ind = self.indenter
@@ -328,24 +340,18 @@ class Scene:
         extent = float(getattr(ind, "extent", math.inf))
         rmax = min(1.5 * L, max(extent, L))
         nr, nth = 401, 96
-        r = np.linspace(0.0, rmax, nr)
+        r = np.union1d(np.linspace(0.0, rmax, nr), [L])              # r = L is a sample
+        nr = r.size
         half = bool(getattr(ind, "symmetric_y", False))
         th = np.linspace(0.0, math.pi if half else 2.0 * math.pi, nth + 1 if half else nth,
                          endpoint=half)
         TH, RR = np.meshgrid(th, r, indexing="ij")                  # (nth, nr)
         X, Y = RR * np.cos(TH), RR * np.sin(TH)
         inside = RR <= L
-        try:
-            with np.errstate(all="ignore"):
-                s_in = np.asarray(ind.gap(X[inside], Y[inside]), dtype=float)
-        except SceneError:
-            raise
-        except Exception as exc:
-            raise SceneError(f"the indenter's gap(x, y) failed on the domain r <= {L:g} "
-                             f"({type(exc).__name__}: {exc}); fix the shape function.") from None
-        if s_in.shape != X[inside].shape or not np.all(np.isfinite(s_in)):
-            raise SceneError(f"the indenter's gap(x, y) must return one finite value per point "
-                             f"on the domain r <= {L:g}; fix the shape function.")
+        s_in = self._sample_gap(X[inside], Y[inside])
+        self._check_gap_rise(s_in)
+        if half:
+            self._check_symmetric_y(X[inside], Y[inside], s_in)
         S = np.full(X.shape, np.inf)
         S[inside] = s_in
         if (~inside).any():
@@ -355,7 +361,7 @@ class Scene:
                 if s_out.shape == X[~inside].shape:
                     # beyond the domain a non-finite gap counts as "no contact"
                     S[~inside] = np.where(np.isfinite(s_out), s_out, np.inf)
-            except Exception:
+            except Exception:  # noqa: BLE001, S110 - beyond the domain a failing gap is "no contact"
                 pass
         hc0 = self.motion.hc(0.0)
         dmin = hc0 + float(s_in.min())
@@ -385,9 +391,15 @@ class Scene:
             Fs = []
             for t in times:
                 try:
-                    Fs.append(abs(self.motion.F(t)))
+                    Ft = call_time_function("the load history F(t)", "F", self.motion.load, t,
+                                            "The load history must return finite values.")
                 except SceneError:
-                    continue                 # the run reports a non-finite load when it gets there
+                    if t == 0.0:
+                        raise
+                    continue                 # the run reports a failing load when it gets there
+                if Ft < 0.0:
+                    raise SceneError(_negative_load_message(Ft, t))
+                Fs.append(Ft)
             F = max(Fs, default=0.0)
             kind = getattr(self.substrate, "kind", "halfspace")
             if F == 0.0 or kind == "rigid":
@@ -444,6 +456,85 @@ class Scene:
                 f"{a / math.sqrt(2.0):.3g} for a sphere), and the pressure must decay before "
                 f"r = L. Use L >= {need_txt} (the paper uses L = 2a)"
                 + (", and extend the height map to cover it." if math.isfinite(extent) else "."))
+
+    def _describe_indenter(self) -> str:
+        name = getattr(self.indenter, "name", None)
+        if isinstance(name, str):
+            return f"the indenter {type(self.indenter).__name__} {name!r}"
+        return f"the indenter {_short(self.indenter, 60)}"
+
+    def _sample_gap(self, x, y) -> np.ndarray:
+        """The indenter's gap on the points (x, y) of the domain: one finite real value per point."""
+        L = self.domain.L
+        what = f"{self._describe_indenter()}: gap(x, y) on the domain r <= {L:g}"
+        try:
+            with np.errstate(all="ignore"):
+                raw = self.indenter.gap(x, y)
+        except SceneError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - the user's shape: name the failure
+            raise SceneError(f"the indenter's gap(x, y) failed on the domain r <= {L:g} "
+                             f"({type(exc).__name__}: {exc}); fix the shape function.") from None
+        s = check_shape_values(what, raw, x.shape, "Fix the shape function.")
+        bad = ~np.isfinite(s)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            if np.isinf(s[k]) and callable(getattr(self.indenter, "domain_hint", None)):
+                raise SceneError(
+                    f"{self._describe_indenter()} is too sharp for the domain r <= {L:g}: its gap "
+                    f"overflows to inf at (x, y) = ({x[k]:.3g}, {y[k]:.3g}). {self._rise_hint()}")
+            cause = ("overflows to inf" if np.isinf(s[k]) else "is NaN")
+            raise SceneError(
+                f"{what} {cause} at (x, y) = ({x[k]:.3g}, {y[k]:.3g}): it must return one finite value "
+                f"per point. {self._rise_hint()}")
+        return s
+
+    def _rise_hint(self) -> str:
+        hint = getattr(self.indenter, "domain_hint", None)
+        if callable(hint):
+            return hint(self.domain.L, GAP_RISE)
+        return (f"Rescale the shape so that its rise across the domain lies in "
+                f"[{GAP_RISE[0]:g}, {GAP_RISE[1]:g}] (units of h_inf), or fix the shape function.")
+
+    def _check_gap_rise(self, s) -> None:
+        """An analytic indenter's gap must rise by GAP_RISE[0] .. GAP_RISE[1] across the domain.
+
+        (Units of h_inf.)  Only indenters with a ``domain_hint`` (the radii of Sphere,
+        Ellipsoid, FlatPunch) are checked: a height map or user shape may be a flat plate.
+
+        Below: the indenter is flat on the domain (a huge radius, a punch face wider than
+        the domain): no contact edge lies inside it and the pressure cannot decay before
+        r = L.  Above: the contact is a dot far below any mesh size (a tiny radius) and
+        the film d^3 spans more than 18 decades.
+        """
+        if not callable(getattr(self.indenter, "domain_hint", None)):
+            return       # a height map or user shape is taken as given (it may be a flat plate)
+        L = self.domain.L
+        rise = float(np.max(s) - np.min(s))
+        lo, hi = GAP_RISE
+        if rise < lo:
+            raise SceneError(
+                f"{self._describe_indenter()} is flat on the domain r <= {L:g}: its gap rises only "
+                f"{rise:.3g} (units of h_inf, less than {lo:g}), so the domain holds no contact "
+                f"edge and the pressure cannot decay before r = L. {self._rise_hint()}")
+        if rise > hi:
+            raise SceneError(
+                f"{self._describe_indenter()} is too sharp for the domain r <= {L:g}: its gap rises "
+                f"to {rise:.3g} (units of h_inf, more than {hi:g}), so the contact is a dot far "
+                f"smaller than any mesh of the domain. {self._rise_hint()}")
+
+    def _check_symmetric_y(self, x, y, s) -> None:
+        """An indenter that declares symmetric_y must have s(x, -y) = s(x, y) on the domain."""
+        s_m = self._sample_gap(x, -y)
+        tol = SYMMETRY_RTOL * max(float(np.ptp(s)), float(np.max(np.abs(s))), np.finfo(float).tiny)
+        err = np.abs(s_m - s)
+        if np.any(err > tol):
+            k = int(np.argmax(err))
+            raise SceneError(
+                f"{self._describe_indenter()} declares symmetric_y=True, but its gap is not "
+                f"symmetric in y on the domain r <= {self.domain.L:g}: s({x[k]:.3g}, {y[k]:.3g}) = "
+                f"{s[k]:.6g} but s({x[k]:.3g}, {-y[k]:.3g}) = {s_m[k]:.6g}. Pass symmetric_y=False "
+                "(the solver then uses the full disk), or make the shape symmetric.")
 
     def _check_times(self):
         """Times at which the gap / load histories are sampled by the domain check."""
@@ -567,7 +658,7 @@ class Dimensional:
         return np.asarray(value) / self.to_si(quantity, 1.0)
 
     #: columns of :meth:`result_table` -> (normalized Result column, scale, SI unit)
-    RESULT_COLUMNS = {
+    RESULT_COLUMNS: ClassVar[dict] = {
         "t": ("t", "time", "s"),
         "hc": ("hc", "height", "m"),
         "load": ("load", "force", "N"),

@@ -27,7 +27,8 @@ ratio >= 1), scheme, t_end, dt, store_every.  See
 ``examples/cylinder_winkler.toml``.
 
 A height map file is an ``.npz`` with arrays x, y, z (``np.savez``), its path
-relative to the scene file.  ``kind = "shape"`` (a Python function) exists
+relative to the scene file; so is a [run] mesh that is not a ladder name
+(coarse, medium, fine, xfine) or an absolute path.  ``kind = "shape"`` (a Python function) exists
 only in Python.
 
 Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
@@ -49,16 +50,35 @@ import pathlib
 
 from .errors import SceneError, SceneFileError
 from .indenters import INDENTERS, si_indenter
-from .scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
-                    Scene, Table, TanhStart, Winkler)
+from .scene import (
+    Constant,
+    Dimensional,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Table,
+    TanhStart,
+    Winkler,
+)
+from .validation import check_finite, check_int
 
 try:
     import tomllib
 except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
-__all__ = ["load_scene_file", "INDENTERS", "SUBSTRATES", "TIME_FUNCTIONS", "RUN_KEYS",
-           "LINE_RUN_KEYS"]
+__all__ = [
+    "INDENTERS",
+    "LINE_RUN_KEYS",
+    "RUN_KEYS",
+    "SUBSTRATES",
+    "TIME_FUNCTIONS",
+    "load_scene_file",
+]
 
 SUBSTRATES = {"halfspace": HalfSpace, "winkler": Winkler, "rigid": Rigid}
 TIME_FUNCTIONS = {"constant": Constant, "table": Table, "ramp_hold": RampHold, "tanh": TanhStart}
@@ -161,6 +181,7 @@ def load_scene_file(path) -> tuple[Scene, dict]:
     extra = set(run) - RUN_KEYS
     if extra:
         raise SceneFileError(f"{path}: [run] does not take {sorted(extra)}; it takes {sorted(RUN_KEYS)}.")
+    _check_run(run, path)
     try:
         if "si" in raw:
             scene, dim = _si_scene(raw, path)
@@ -172,6 +193,28 @@ def load_scene_file(path) -> tuple[Scene, dict]:
     except SceneError as exc:
         raise SceneFileError(f"{path}: {exc}") from None
     return scene, run
+
+
+def _check_run(run: dict, path: pathlib.Path) -> None:
+    """Check the [run] keys femehl can check without a solver; resolve ``mesh`` (in place).
+
+    ``dtheta_divisions`` must be an integer >= 2.  A ``mesh`` that is neither a ladder
+    name nor an absolute path is a file relative to the scene file's folder (like a
+    height map's ``file``).
+    """
+    if "dtheta_divisions" in run:
+        check_int(f"{path}: [run] dtheta_divisions", run["dtheta_divisions"], minimum=2,
+                  hint="It is the number of angular divisions of the half turn (dtheta = pi/n), "
+                       "e.g. dtheta_divisions = 30.", error=SceneFileError)
+    if "mesh" in run:
+        mesh = run["mesh"]
+        if not isinstance(mesh, str) or not mesh.strip():
+            raise SceneFileError(f"{path}: [run] mesh must be a ladder name (coarse, medium, fine, "
+                                 f"xfine) or the path of a mesh file, got {mesh!r}.")
+        from .fe.mesh import LADDER  # lazy: only scene files that name a mesh need the FE code
+
+        if mesh not in LADDER and not pathlib.Path(mesh).is_absolute():
+            run["mesh"] = str(pathlib.Path(path).parent / mesh)
 
 
 def _si_scene(raw, path):
@@ -203,7 +246,6 @@ def _si_scene(raw, path):
             kind = ind.pop("kind", None)
             changes["indenter"] = si_indenter(kind, ind, dim)
         if "load" in si:
-            from .scene import check_finite
             F = check_finite("[si] load [N]", si["load"]) / dim.force
             changes["motion"] = Motion(gap=Constant(scene.motion.hc(0.0)),
                                        velocity=scene.motion.velocity, load=Constant(F))

@@ -1,4 +1,15 @@
-"""Validators of scalar input: small functions whose messages name the fix."""
+"""Small input validators shared by the scene, indenter and mesh modules.
+
+Each validator takes a *name* (how the value is called in the error message), the
+value and, optionally, a *hint* (what to do about a bad value), and either returns
+the value converted (a float, a checked array) or raises
+:class:`~femehl.errors.SceneError` naming the value, what is wrong and the fix.
+Inputs are never mutated: arrays are copied before they are changed.
+
+This module imports nothing from the rest of femehl but :mod:`femehl.errors`, so
+:mod:`femehl.scene` and :mod:`femehl.indenters` can both use it without an import
+cycle.  ``femehl.scene.check_finite`` / ``check_positive`` re-export the functions.
+"""
 
 from __future__ import annotations
 
@@ -9,12 +20,28 @@ import numpy as np
 
 from .errors import SceneError
 
-__all__ = ["check_finite", "check_positive"]
+__all__ = [
+    "call_time_function",
+    "check_finite",
+    "check_int",
+    "check_nonnegative",
+    "check_positive",
+    "check_shape_values",
+    "short",
+]
 
 
-def _short(value) -> str:
+def short(value, width: int = 40) -> str:
+    """``repr(value)``, cut to ``width`` characters (for error messages)."""
     r = repr(value)
-    return r if len(r) <= 40 else r[:37] + "..."
+    return r if len(r) <= width else r[: width - 3] + "..."
+
+
+_short = short  # the historic name in femehl.scene
+
+
+def _join(message: str, hint: str) -> str:
+    return f"{message} {hint}".strip()
 
 
 def check_finite(name: str, value, hint: str = "") -> float:
@@ -24,14 +51,14 @@ def check_finite(name: str, value, hint: str = "") -> float:
     (a "1" in a scene is a typo, not a number).
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise SceneError(f"{name} must be a real number, got {_short(value)} "
-                         f"({type(value).__name__}). {hint}".strip())
+        raise SceneError(_join(f"{name} must be a real number, got {short(value)} "
+                               f"({type(value).__name__}).", hint))
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise SceneError(f"{name} must be a finite number, got {_short(value)}. {hint}".strip()) from None
+        raise SceneError(_join(f"{name} must be a finite number, got {short(value)}.", hint)) from None
     if not math.isfinite(v):
-        raise SceneError(f"{name} must be finite, got {v}. {hint}".strip())
+        raise SceneError(_join(f"{name} must be finite, got {v}.", hint))
     return v
 
 
@@ -39,5 +66,69 @@ def check_positive(name: str, value, hint: str = "") -> float:
     """Return ``value`` as a float, or raise SceneError if it is not finite and > 0."""
     v = check_finite(name, value, hint)
     if v <= 0.0:
-        raise SceneError(f"{name} must be > 0, got {v}. {hint}".strip())
+        raise SceneError(_join(f"{name} must be > 0, got {v}.", hint))
     return v
+
+
+def check_nonnegative(name: str, value, hint: str = "") -> float:
+    """Return ``value`` as a float, or raise SceneError if it is not finite and >= 0."""
+    v = check_finite(name, value, hint)
+    if v < 0.0:
+        raise SceneError(_join(f"{name} must be >= 0, got {v:g}.", hint))
+    return v
+
+
+def check_int(name: str, value, minimum: int | None = None, hint: str = "", error=SceneError) -> int:
+    """Return ``value`` as an int, or raise ``error`` if it is not an integer >= ``minimum``.
+
+    Booleans and floats (even 3.0) are refused: a count is written as an integer.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise error(_join(f"{name} must be an integer, got {short(value)} ({type(value).__name__}).",
+                          hint))
+    v = int(value)
+    if minimum is not None and v < minimum:
+        raise error(_join(f"{name} must be an integer >= {minimum}, got {v}.", hint))
+    return v
+
+
+def check_shape_values(what: str, values, shape: tuple, hint: str = "") -> np.ndarray:
+    """Check what a user function returned on points of array shape ``shape``.
+
+    Returns a new float array of that shape (a scalar is broadcast); raises
+    SceneError for complex values, non-numbers, the wrong shape, NaN or inf.
+    """
+    a = np.asarray(values)
+    if np.iscomplexobj(a):
+        raise SceneError(_join(f"{what} returned complex values (e.g. {complex(a.ravel()[0]):.3g}): "
+                               "a gap is a real number; return the real part or fix the formula "
+                               "(a square root of a negative number?).", hint))
+    try:
+        a = np.array(a, dtype=float)          # a copy: the caller's array is never touched
+    except (TypeError, ValueError):
+        raise SceneError(_join(f"{what} must return real numbers, got {type(values).__name__}.",
+                               hint)) from None
+    if a.shape != tuple(shape):
+        if a.ndim != 0:
+            raise SceneError(_join(f"{what} returned shape {a.shape} for inputs of shape "
+                                   f"{tuple(shape)}: return one value per point (vectorize with numpy).",
+                                   hint))
+        a = np.full(shape, float(a))
+    return a
+
+
+def call_time_function(history: str, symbol: str, f, t: float, hint: str = "") -> float:
+    """``f(t)`` as a finite float; an exception of ``f`` becomes a SceneError naming the history and t.
+
+    ``history`` names the function in words (``"the gap history hc(t)"``), ``symbol``
+    in the formula (``"hc"``: a bad value is reported as ``hc(t=0.5) must be finite``).
+    """
+    t = float(t)
+    try:
+        v = f(t)
+    except SceneError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the user's code: say which history failed, and when
+        raise SceneError(f"{history} raised {type(exc).__name__} at t = {t:g} ({exc}): fix the "
+                         "function so that it returns a finite number at every time of the run.") from None
+    return check_finite(f"{symbol}(t={t:g})", v, hint)

@@ -226,7 +226,7 @@ def test_error_nonexistent_file(tmp_path):
 def test_error_garbage_file(tmp_path, suffix, capsys):
     path = tmp_path / f"garbage{suffix}"
     path.write_text("this is not a mesh\n1 2 3\n")
-    with pytest.raises(MeshError, match=r"cannot read mesh file.*meshio reads.*\.msh"):
+    with pytest.raises(MeshError, match=r"is not a mesh meshio can read.*meshio reads.*\.msh"):
         load_mesh(path)
     out = capsys.readouterr()
     assert out.out == "" and out.err == ""  # meshio's chatter is captured

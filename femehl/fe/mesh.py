@@ -72,6 +72,7 @@ so the orientation is kept.  Input objects are never mutated.
 from __future__ import annotations
 
 import contextlib
+import difflib
 import hashlib
 import io
 import json
@@ -87,14 +88,20 @@ import skfem
 from femehl.errors import MeshError
 
 __all__ = [
-    "DiskMesh",
     "LADDER",
     "LADDER_RATIO",
+    "MAX_GMSH_ELEMENTS",
+    "MEMORY_FRACTION",
+    "DiskMesh",
     "areas",
     "centroids",
+    "check_mesh_memory",
+    "estimate_elements",
     "graded_disk",
     "ladder_path",
     "load_mesh",
+    "machine_memory",
+    "operator_bytes",
 ]
 
 #: Relative tolerance of "on the circle r = L" / "on the line y = 0" / "radius == L".
@@ -109,6 +116,16 @@ _AREA_RTOL_MIN = 1e-3
 _EDGE_TRANSITION = 0.15
 
 _READABLE = "e.g. gmsh .msh, VTK .vtu or XDMF .xdmf"
+
+#: Refuse a mesh whose dense elastic operator (with the LU working copies) needs more
+#: than this fraction of the machine's physical memory.
+MEMORY_FRACTION = 0.6
+#: The dense elastic operator is elements x free nodes x 8 bytes; the solver holds about
+#: this many such arrays at once (the operator, the dense system and its LU copy, work).
+_OPERATOR_COPIES = 4
+#: graded_disk refuses sizes that would make more elements than this (gmsh would run
+#: for hours and the solver could not hold the operator anyway).
+MAX_GMSH_ELEMENTS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -259,6 +276,70 @@ def _write_msh(dm: DiskMesh, path: pathlib.Path) -> None:
             os.remove(tmp)
 
 
+
+# ---------------------------------------------------------------------------
+# size and memory guards
+
+
+def machine_memory() -> int | None:
+    """Physical memory of this machine in bytes, or None if the OS does not say."""
+    try:
+        n = int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError, TypeError):
+        return None
+    return n if n > 0 else None
+
+
+def operator_bytes(n_elements: int, n_free: int) -> int:
+    """Bytes of the dense elastic operator (elements x free nodes x 8), before the LU copies."""
+    return int(n_elements) * int(n_free) * 8
+
+
+def _gb(n: float) -> str:
+    return f"{n / 1e9:.3g} GB"
+
+
+def check_mesh_memory(n_elements: int, n_free: int, name: str, memory: int | None = None) -> None:
+    """Raise MeshError if the dense elastic operator of this mesh would not fit in memory.
+
+    The half-space substrate needs a dense ``elements x free nodes`` float64 operator,
+    and the solver holds about ``_OPERATOR_COPIES`` arrays of that size (system, LU).
+    Refused when that exceeds :data:`MEMORY_FRACTION` of the physical memory
+    (``memory``, default :func:`machine_memory`; no check if it is unknown).
+    """
+    memory = machine_memory() if memory is None else memory
+    if memory is None:
+        return
+    one = operator_bytes(n_elements, n_free)
+    need = _OPERATOR_COPIES * one
+    if need > MEMORY_FRACTION * memory:
+        raise MeshError(
+            f"mesh {name}: {n_elements} elements and about {n_free} free nodes need a dense elastic "
+            f"operator of {_gb(one)} (elements x free nodes x 8 bytes), about {_gb(need)} with the "
+            f"LU working copies, more than {MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} "
+            f"of memory; use a coarser mesh (a ladder name: {', '.join(LADDER)}) or larger "
+            "mesh sizes"
+        )
+
+
+def estimate_elements(L, half, h) -> float:
+    """About how many triangles gmsh makes under the size function ``h(r)``.
+
+    An equilateral triangle of side ``h`` has area ``sqrt(3) h^2 / 4``, so the count
+    is ``int 4 / (sqrt(3) h(r)^2) dA`` over the (half) disk; the ladder meshes have
+    about 12 % more (gmsh's triangles are not all equilateral).
+    """
+    r = np.linspace(0.0, L, 4001)
+    return _element_integral(r, L, half, h)
+
+
+def _element_integral(r, L, half, h) -> float:
+    with np.errstate(over="ignore"):
+        dens = np.array([1.0 / h(float(x)) ** 2 for x in r]) * r
+    span = math.pi if half else 2.0 * math.pi
+    return float(span * np.trapezoid(dens, r) * 4.0 / math.sqrt(3.0))
+
+
 # ---------------------------------------------------------------------------
 # generation
 
@@ -328,7 +409,7 @@ def graded_disk(
         If a size or radius is not positive and finite, or ``r_edge`` is not
         an increasing pair.
     """
-    vals = dict(L=L, h_far=h_far, h_contact=h_contact, h_edge=h_edge, r_contact=r_contact)
+    vals = {"L": L, "h_far": h_far, "h_contact": h_contact, "h_edge": h_edge, "r_contact": r_contact}
     for k, v in vals.items():
         if not (isinstance(v, (int, float, np.number)) and math.isfinite(v) and v > 0):
             raise MeshError(f"graded_disk: {k} = {v!r} must be a positive finite number")
@@ -345,6 +426,20 @@ def graded_disk(
         )
     L = float(L)
     h = _size_function(L, float(h_far), float(h_contact), float(h_edge), float(r_contact), (a, b))
+    # sample finely where h dips (the edge annulus and its transitions), then refuse
+    # sizes that would make gmsh run for hours or the operator overflow the memory
+    w = _EDGE_TRANSITION
+    r = np.union1d(np.linspace(0.0, L, 4001),
+                   np.linspace(max(a - w, 0.0), max(min(b + w, L), max(a - w, 0.0)), 2001))
+    ne = _element_integral(r[r <= L], L, bool(half), h)
+    if not ne <= MAX_GMSH_ELEMENTS:
+        raise MeshError(
+            f"graded_disk: sizes h_far = {h_far}, h_contact = {h_contact}, h_edge = {h_edge} on L = "
+            f"{L:g} would make about {ne:.3g} elements, more than {MAX_GMSH_ELEMENTS:.0e} (gmsh "
+            "would run for hours and no machine holds the dense elastic operator); pass larger "
+            "mesh sizes"
+        )
+    check_mesh_memory(int(ne), int(ne / 2), f"graded_disk(L={L:g}, ...) (estimated)")
     p, t, on_arc, on_line = _gmsh_disk(L, bool(half), h)
     # Exact boundary: arc nodes onto r = L, mirror-line nodes onto y = 0.
     r = np.hypot(p[0, on_arc], p[1, on_arc])
@@ -431,7 +526,7 @@ def _gmsh_disk(L, half, h):
                     gmsh.model.setCurrent(model)
                     gmsh.model.remove()
                     gmsh.model.setCurrent(previous_model)
-                except Exception:  # pragma: no cover - best effort
+                except Exception:  # noqa: BLE001, S110  # pragma: no cover - best effort
                     pass
             for k, v in saved.items():
                 gmsh.option.setNumber(k, v)
@@ -487,6 +582,7 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
     over the mesh's own boundary chords on the circle (``A0`` the exact area).
     """
     if isinstance(spec, DiskMesh):
+        _check_memory_of(spec.mesh.t, spec.name)
         p0 = np.asarray(spec.mesh.p)
         t0 = np.asarray(spec.mesh.t)
         want_half = spec.half if half is None else bool(half)
@@ -503,6 +599,7 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
         return DiskMesh(_make_meshtri(p, t), float(L), h, spec.name)
 
     if isinstance(spec, skfem.MeshTri):
+        _check_memory_of(spec.t, "<MeshTri>")
         p = np.array(spec.p[:2], dtype=np.float64)  # copies
         t = np.array(spec.t[:3], dtype=np.int64)
         p, t, h = _normalize(p, t, L, half, "<MeshTri>")
@@ -515,6 +612,7 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
             return graded_disk(L=float(L), half=half, name=spec, **LADDER[spec])
         path = ladder_path(spec, half)
         p, t = _read_file(path, 2.0, "gmsh")
+        _check_memory_of(t, spec)
         p, t, h = _normalize(p, t, 2.0, half, spec)
         return DiskMesh(_make_meshtri(p, t), 2.0, h, spec)
 
@@ -522,6 +620,7 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
         path = pathlib.Path(spec)
         _check_l(L)
         p, t = _read_file(path, L)
+        _check_memory_of(t, str(path))
         p, t, h = _normalize(p, t, L, half, str(path))
         return DiskMesh(_make_meshtri(p, t), float(L), h, str(path))
 
@@ -580,6 +679,13 @@ def _make_meshtri(p: np.ndarray, t: np.ndarray) -> skfem.MeshTri:
     )
 
 
+def _check_memory_of(t, name) -> None:
+    """check_mesh_memory for triangles ``t`` (3, ne): free nodes estimated by the used nodes."""
+    t = np.asarray(t)
+    if t.ndim == 2 and t.shape[0] >= 3 and t.size:
+        check_mesh_memory(t.shape[1], np.unique(t[:3]).size, name)
+
+
 def _check_l(L) -> None:
     if not (isinstance(L, (int, float, np.number)) and math.isfinite(L) and L > 0):
         raise MeshError(f"L = {L!r} must be a positive finite number (the disk radius)")
@@ -589,25 +695,37 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
     """Read the triangles of a mesh file: nodes (2, n), triangles (3, ne)."""
     import meshio
 
-    if not path.is_file():
+    if path.is_dir():
         raise MeshError(
-            f"mesh file '{path}' does not exist; pass an existing mesh file ({_READABLE}) "
+            f"mesh path '{path}' is a directory, not a mesh file; pass a mesh file in it "
+            f"({_READABLE}) or a ladder name ({', '.join(LADDER)})"
+        )
+    if not path.exists():
+        close = difflib.get_close_matches(str(path), list(LADDER), n=1)
+        hint = f" (did you mean the ladder mesh {close[0]!r}?)" if close else ""
+        raise MeshError(
+            f"mesh file '{path}' does not exist{hint}; pass an existing mesh file ({_READABLE}) "
             f"or a ladder name ({', '.join(LADDER)})"
         )
+    if not path.is_file():
+        raise MeshError(f"mesh path '{path}' is not a regular file; pass a mesh file ({_READABLE})")
+    if not os.access(path, os.R_OK):
+        raise MeshError(f"mesh file '{path}' is not readable (permission denied); fix its "
+                        "permissions or pass a copy you can read")
     # meshio prints the errors of the formats it tries (.msh: ansys, then gmsh)
     # and calls sys.exit when none works: capture the output, catch the exit.
     chatter = io.StringIO()
     try:
         with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
             m = meshio.read(path, file_format=file_format)
-    except (Exception, SystemExit) as exc:  # meshio raises many kinds: wrap them all
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many kinds: wrap them all
         said = " ".join(chatter.getvalue().split())
         if isinstance(exc, SystemExit) or not str(exc):
             detail = said or type(exc).__name__
         else:
             detail = f"{type(exc).__name__}: {exc}"
         raise MeshError(
-            f"cannot read mesh file '{path}' ({detail}); "
+            f"'{path}' is not a mesh meshio can read ({detail}); "
             f"pass a file in a format meshio reads, {_READABLE}"
         ) from None
     blocks = [np.asarray(c.data) for c in m.cells if c.type == "triangle"]

@@ -323,15 +323,16 @@ def resume_command(argv, out) -> str:
     return shlex.join(["femehl", *words, "--resume", "--out", str(out)])
 
 
-def _interrupted(exc, args, argv) -> int:
+def _interrupted(args, argv) -> int:
+    """Ctrl-C: say what is in the output folder and how to go on; exit status 130."""
     import pathlib
 
     out = getattr(args, "out_folder", None)
-    if out is not None and hasattr(exc, "result") and (pathlib.Path(out) / "checkpoint.npz").is_file():
+    if out is not None and (pathlib.Path(out) / "checkpoint.npz").is_file():
         print(f"femehl: interrupted; what was written is in {out}. To go on:\n  "
               f"{resume_command(argv, out)}", file=sys.stderr)
     else:
-        print("femehl: interrupted before the run started; nothing was written.", file=sys.stderr)
+        print("femehl: interrupted before the run wrote a checkpoint; nothing to resume.", file=sys.stderr)
     return EXIT_INTERRUPTED
 
 
@@ -347,8 +348,8 @@ def main(argv=None) -> int:
         except FemehlError as exc:
             print(f"femehl: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
-        except KeyboardInterrupt as exc:
-            return _interrupted(exc, args, argv)
+        except KeyboardInterrupt:
+            return _interrupted(args, argv)
 
 
 if __name__ == "__main__":

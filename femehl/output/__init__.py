@@ -20,6 +20,8 @@ __all__ = [
     "SeriesWriter",
     "SummaryWriter",
     "centreline_png",
+    "check_folder",
+    "prepare_folder",
     "profile_times",
     "quicklook_png",
     "write_all",

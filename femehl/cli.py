@@ -124,7 +124,7 @@ def _run(args):
     run = _method_options(run, method, from_cli=args.method is not None)
     for key in ("scheme", "mesh", "dt", "t_end", "store_every"):
         v = getattr(args, key)
-        if v is not None:
+        if v is not None and not (key == "scheme" and method == "fd"):    # fd: euler, its own scheme
             run[key] = v
     if args.dr is not None:
         run["dr"] = check_step("--dr", args.dr)

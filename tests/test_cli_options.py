@@ -57,6 +57,13 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, args, words):
     assert not out.exists()
 
 
+def test_fd_accepts_scheme_euler(tmp_path):
+    out = tmp_path / "o"
+    assert main(["run", "--method", "fd", "--scheme", "euler", "--dr", "0.2", "--dtheta-divisions", "8",
+                 "--t-end", "0.04", "--dt", "0.02", "--out", str(out), "--quiet"]) == 0
+    assert len(_rows(out)) == 1 + 3
+
+
 def test_scene_file_options_of_the_other_method_are_refused(tmp_path, capsys):
     f = tmp_path / "s.toml"
     f.write_text('[run]\nmethod = "fd"\nmesh = "coarse"\n')

@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 import femehl
 import femehl.run
 from femehl.errors import CheckpointError, OutputError, SceneError
-from femehl.output import checkpoint
+from femehl.output import checkpoint, write_all
 from femehl.output.series import scan_series
 from femehl.run import run_to_folder
 
@@ -245,6 +245,29 @@ def test_result_save_checks_the_folder(tmp_path):
     with pytest.raises(OutputError, match="already holds a run"):
         res.save(tmp_path / "r")
     assert _snapshot(tmp_path / "r") == before
+    (tmp_path / "r" / "fields_000009.vtu").write_bytes(USER)          # a stale file of that run
+    (tmp_path / "r" / "notes.txt").write_bytes(USER)
+    write_all(res, tmp_path / "r", overwrite=True)
+    assert not (tmp_path / "r" / "fields_000009.vtu").exists()
+    assert (tmp_path / "r" / "notes.txt").read_bytes() == USER
+
+
+def test_a_write_failure_names_the_folder_and_keeps_the_last_checkpoint(tmp_path, monkeypatch):
+    from femehl.output.table import SummaryWriter
+
+    real, calls = SummaryWriter.write, [0]
+
+    def write(self, state):
+        calls[0] += 1
+        if calls[0] > 3:
+            raise OSError(28, "No space left on device")
+        return real(self, state)
+    monkeypatch.setattr(SummaryWriter, "write", write)
+    with pytest.raises(OutputError) as info:
+        _run(tmp_path, t_end=0.1)
+    assert str(tmp_path) in str(info.value) and "resume" in str(info.value)
+    assert "No space left" in str(info.value)
+    assert checkpoint.load_checkpoint(tmp_path).t == pytest.approx(0.04)   # the last state written
 
 
 # ---- Ctrl-C ----------------------------------------------------------------------------------

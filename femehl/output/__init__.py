@@ -3,6 +3,9 @@
 Nothing here steps a solver.  :class:`RunWriter` is the callback a run
 hands each State to, so files appear while the run goes; :func:`write_all`
 writes the same from a finished :class:`~femehl.result.Result`.
+:mod:`femehl.output.folder` decides whether a folder may be written (it
+refuses one that holds another run unless asked to overwrite or resume), and
+:mod:`femehl.output._validation` checks run and command-line options first.
 """
 
 from __future__ import annotations

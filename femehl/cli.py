@@ -87,7 +87,7 @@ def _method_options(run: dict, method: str, from_cli: bool) -> dict:
     return out
 
 
-def _run(args):
+def _run(args, argv=()):
     from . import presets
     from .output._validation import (
         METHOD_FLAGS,
@@ -138,10 +138,12 @@ def _run(args):
     else:
         run.setdefault("mesh", "medium")
     out = args.out or f"{DEFAULT_OUT}/{name}"
-    args.out_folder = out                        # for main's resume hint
-    res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
-                        store_every=run.pop("store_every", 10), progress=not args.quiet,
-                        resume=resume, overwrite=overwrite, **run)
+    try:
+        res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
+                            store_every=run.pop("store_every", 10), progress=not args.quiet,
+                            resume=resume, overwrite=overwrite, **run)
+    except KeyboardInterrupt:
+        return _interrupted(out, argv)
     print(f"femehl: done in {res.info['wall_s']:.1f} s; wrote {out}/summary.csv, fields.pvd, centreline.png, fields.png")
     if dim is not None:
         print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
@@ -323,11 +325,10 @@ def resume_command(argv, out) -> str:
     return shlex.join(["femehl", *words, "--resume", "--out", str(out)])
 
 
-def _interrupted(args, argv) -> int:
-    """Ctrl-C: say what is in the output folder and how to go on; exit status 130."""
+def _interrupted(out, argv) -> int:
+    """Ctrl-C during a run: say what is in the output folder and how to go on; exit status 130."""
     import pathlib
 
-    out = getattr(args, "out_folder", None)
     if out is not None and (pathlib.Path(out) / "checkpoint.npz").is_file():
         print(f"femehl: interrupted; what was written is in {out}. To go on:\n  "
               f"{resume_command(argv, out)}", file=sys.stderr)
@@ -341,7 +342,9 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     with _log_to_stderr():
         try:
-            return {"run": _run, "bench": _bench}[args.command](args)
+            if args.command == "run":
+                return _run(args, argv)
+            return _bench(args)
         except SolverError as exc:
             print(f"femehl: error: {exc}", file=sys.stderr)
             return EXIT_STOPPED
@@ -349,7 +352,7 @@ def main(argv=None) -> int:
             print(f"femehl: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
         except KeyboardInterrupt:
-            return _interrupted(args, argv)
+            return _interrupted(None, argv)
 
 
 if __name__ == "__main__":

@@ -3,8 +3,14 @@
 ``femehl run`` without a file runs the built-in default: the paper's sphere
 (beta = 200, h0 = 0.1) to t = 5 with the FE solver on the "medium" mesh,
 which takes well under a minute here.  Options override the file's [run].
-Exit status: 0 done, 2 bad input, 3 the run stopped (film rupture,
-singular system) after writing what it had.
+Exit status: 0 done, 2 bad input (nothing written), 3 the run stopped (film
+rupture, singular system) after writing what it had, 130 interrupted (Ctrl-C:
+what was written stays readable and the command to resume is printed).
+
+An output folder that already holds a run is refused unless ``--overwrite``
+(replaces femehl's files of that run; other files stay) or ``--resume``.
+Options that do not apply to the chosen method are refused.  The run's
+reports go to stderr (logger "femehl"), the figures reached to stdout.
 
 A scene file with ``[indenter] kind = "cylinder"`` is line contact (a
 :class:`femehl.line.LineScene`): it is run by :func:`femehl.line.solve_line`
@@ -14,12 +20,18 @@ and writes summary.csv (same columns, y = 0) and line.png.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import logging
 import math
+import shlex
 import sys
 
 from .errors import FemehlError, SolverError
 
 DEFAULT_OUT = "femehl-out"
+EXIT_DONE, EXIT_BAD_INPUT, EXIT_STOPPED, EXIT_INTERRUPTED = 0, 2, 3, 130
+
+logger = logging.getLogger("femehl")
 
 
 def _parser():
@@ -42,14 +54,48 @@ def _parser():
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--resume", action="store_true",
                    help="continue the run in the output folder from its checkpoint.npz")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace the run already in the output folder (its femehl files only)")
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument("what", choices=["accuracy", "stress"], help="which study")
     b.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
-def _run(args):
+FD_KEYS = ("dr", "dtheta")
+RUN_KEYS = ("dt", "t_end", "store_every", "checkpoint_every")
+
+
+def _method_options(run: dict, method: str, from_cli: bool) -> dict:
+    """The [run] options that belong to ``method``; the other method's are refused.
+
+    When ``--method`` overrode the file's method, the file's options of the other
+    method are dropped (with a note) instead.
+    """
+    out = dict(run)
+    if method == "fd":
+        other = [k for k in out if k not in FD_KEYS + RUN_KEYS and not (k == "scheme" and out[k] == "euler")]
+    else:
+        other = [k for k in out if k in FD_KEYS]
+    if other and not from_cli:
+        fix = "give --mesh instead" if method == "fe" else "drop it or use --method fe"
+        raise FemehlError(f"[run] {', '.join(other)} do(es) not apply to method {method!r}: {fix}.")
+    if other:
+        logger.info("femehl: --method %s: ignoring the scene file's [run] %s", method, ", ".join(other))
+    for k in other + (["scheme"] if method == "fd" else []):
+        out.pop(k, None)
+    return out
+
+
+def _run(args, argv=()):
     from . import presets
+    from .output._validation import (
+        METHOD_FLAGS,
+        check_divisions,
+        check_method_flags,
+        check_resume_overwrite,
+        check_step,
+    )
     from .run import run_to_folder
     from .scenefile import load_scene_file, run_options
 
@@ -70,42 +116,60 @@ def _run(args):
     if args.n_elements is not None:
         raise FemehlError("--n-elements is a line contact option ([indenter] kind = \"cylinder\"); "
                           "with a 2-D scene give --mesh (fe) or --dr (fd) instead.")
+    resume, overwrite = check_resume_overwrite(args.resume, args.overwrite)
     run = run_options(run)
-    for key in ("method", "scheme", "mesh", "dr", "dt", "t_end", "store_every"):
+    method = args.method or run.pop("method", "fe")
+    run.pop("method", None)
+    check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
+    run = _method_options(run, method, from_cli=args.method is not None)
+    for key in ("scheme", "mesh", "dt", "t_end", "store_every"):
         v = getattr(args, key)
-        if v is not None:
+        if v is not None and not (key == "scheme" and method == "fd"):    # fd: euler, its own scheme
             run[key] = v
+    if args.dr is not None:
+        run["dr"] = check_step("--dr", args.dr)
     if args.dtheta_divisions is not None:
-        run["dtheta"] = math.pi / args.dtheta_divisions
-    method = run.pop("method", "fe")
+        run["dtheta"] = math.pi / check_divisions(args.dtheta_divisions)
     if method == "fd":
         # the coarsest FD grid found to survive the paper case's sliding start-up
         # (coarser ones rupture at the exit: see the FD module docstring)
         run.setdefault("dr", 0.0125)
         run.setdefault("dtheta", math.pi / 36)
-        for k in ("mesh", "linear_solver", "scheme"):
-            if k in run and not (k == "scheme" and run[k] == "euler"):
-                if k != "mesh":
-                    raise FemehlError(f"{k} is an FE option; the FD reference uses the paper's "
-                                      "scheme (drop it or use --method fe).")
-            run.pop(k, None)
     else:
         run.setdefault("mesh", "medium")
-        for k in ("dr", "dtheta"):
-            if k in run:
-                raise FemehlError(f"{k} is an FD option; with method 'fe' give --mesh instead.")
     out = args.out or f"{DEFAULT_OUT}/{name}"
-    res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
-                        store_every=run.pop("store_every", 10), progress=not args.quiet,
-                        resume=args.resume, **run)
+    try:
+        res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
+                            store_every=run.pop("store_every", 10), progress=not args.quiet,
+                            resume=resume, overwrite=overwrite, **run)
+    except KeyboardInterrupt:
+        return _interrupted(out, argv)
     print(f"femehl: done in {res.info['wall_s']:.1f} s; wrote {out}/summary.csv, fields.pvd, centreline.png, fields.png")
     if dim is not None:
-        print(f"femehl: wrote {_write_si_summary(dim, res, out)} (SI units)")
+        print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
     for t in sorted({1.0, float(res.t[-1])}):
         if t <= res.t[-1] + 1e-9:
             print(f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
                   f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}")
     return 0
+
+
+class _SummaryFile:
+    """The whole summary.csv of a run folder, as ``summary()`` columns (a resumed run included)."""
+
+    def __init__(self, folder):
+        import pathlib
+        self.path = pathlib.Path(folder) / "summary.csv"
+
+    def summary(self) -> dict:
+        import csv
+
+        import numpy as np
+
+        with open(self.path, newline="") as fh:
+            rows = list(csv.reader(fh))
+        head, body = rows[0], np.array(rows[1:], dtype=float).reshape(-1, len(rows[0]))
+        return {c: body[:, i] for i, c in enumerate(head)}
 
 
 def _run_line(scene, run, args, name):
@@ -197,22 +261,25 @@ def _line_png(res, path):
 def _write_si_summary(dim, result, out):
     """``out/summary_si.csv``: the per-step table in SI units (scene stated with [si])."""
     import csv
+    import os
     import pathlib
 
     table = dim.result_table(result)
     path = pathlib.Path(out) / "summary_si.csv"
+    tmp = path.with_name(path.name + ".tmp")
     cols = list(table)
-    with open(path, "w", newline="") as fh:
+    with open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow([f"{c}_{dim.RESULT_COLUMNS[c][2]}" for c in cols])
         for i in range(len(table["t"])):
             w.writerow([f"{table[c][i]:.10g}" for c in cols])
+    os.replace(tmp, path)
     return path
 
 
 def _bench(args):
-    import runpy
     import pathlib
+    import runpy
 
     root = pathlib.Path(__file__).resolve().parents[1] / "benchmarks"
     script = root / f"{args.what}.py"
@@ -224,16 +291,68 @@ def _bench(args):
     return 0
 
 
-def main(argv=None) -> int:
-    args = _parser().parse_args(argv)
+@contextlib.contextmanager
+def _log_to_stderr():
+    """femehl's log lines (INFO and up) as plain lines on stderr, for the time of one command."""
+    logger = logging.getLogger("femehl")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    saved = logger.level, logger.propagate
+    logger.setLevel(logging.INFO)
+    logger.propagate = False
+    logger.addHandler(handler)
     try:
-        return {"run": _run, "bench": _bench}[args.command](args)
-    except SolverError as exc:
-        print(f"femehl: error: {exc}", file=sys.stderr)
-        return 3
-    except FemehlError as exc:
-        print(f"femehl: error: {exc}", file=sys.stderr)
-        return 2
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(saved[0])
+        logger.propagate = saved[1]
+
+
+def resume_command(argv, out) -> str:
+    """The ``femehl ...`` command line that resumes the run of ``argv`` in ``out``."""
+    words, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+            continue
+        if a == "--out":
+            skip = True
+            continue
+        if a in ("--resume", "--overwrite") or a.startswith("--out="):
+            continue
+        words.append(a)
+    return shlex.join(["femehl", *words, "--resume", "--out", str(out)])
+
+
+def _interrupted(out, argv) -> int:
+    """Ctrl-C during a run: say what is in the output folder and how to go on; exit status 130."""
+    import pathlib
+
+    if out is not None and (pathlib.Path(out) / "checkpoint.npz").is_file():
+        print(f"femehl: interrupted; what was written is in {out}. To go on:\n  "
+              f"{resume_command(argv, out)}", file=sys.stderr)
+    else:
+        print("femehl: interrupted before the run wrote a checkpoint; nothing to resume.", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = _parser().parse_args(argv)
+    with _log_to_stderr():
+        try:
+            if args.command == "run":
+                return _run(args, argv)
+            return _bench(args)
+        except SolverError as exc:
+            print(f"femehl: error: {exc}", file=sys.stderr)
+            return EXIT_STOPPED
+        except FemehlError as exc:
+            print(f"femehl: error: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        except KeyboardInterrupt:
+            return _interrupted(None, argv)
 
 
 if __name__ == "__main__":

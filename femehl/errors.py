@@ -55,3 +55,11 @@ class RelaxationDivergedError(SolverError):
     def __init__(self, message: str, t: float, iterations: int):
         super().__init__(message, t)
         self.iterations = iterations
+
+
+class OutputError(FemehlError, ValueError):
+    """An output folder cannot be used as asked (holds another run, is a file, is not writable)."""
+
+
+class CheckpointError(OutputError):
+    """A checkpoint to resume from is missing, unreadable or does not fit the run."""

@@ -1,28 +1,86 @@
 """Run a scene into an output folder: summary CSV and field series written as it goes.
 
-This is what ``femehl run`` does, usable from Python too.  If the run stops
-on a :class:`~femehl.errors.SolverError` (film rupture, singular system),
-everything written so far stays readable, the PNGs are drawn from the
-states reached, and the error is re-raised with ``error.result`` set to the
-partial :class:`~femehl.result.Result`.
+This is what ``femehl run`` does, usable from Python too.  The marching is
+:func:`femehl.api.run_loop`; here each new State is written (summary row,
+field series, checkpoint) as it comes.  Every option and the folder are checked
+before anything in the folder is touched: a folder that already holds a run is
+refused unless ``overwrite`` (its femehl files are replaced; other files stay)
+or ``resume`` (it is continued from its checkpoint).
+
+If the run stops on a :class:`~femehl.errors.SolverError` (film rupture,
+singular system) or is interrupted (KeyboardInterrupt, Ctrl-C), everything
+written so far stays readable, the checkpoint holds the last good state, the
+PNGs are drawn from the states reached, and the exception is re-raised with
+``exc.result`` set to the partial :class:`~femehl.result.Result`.
+
+Reports go to the :mod:`logging` logger ``"femehl"`` (INFO); nothing is printed.
 """
 
 from __future__ import annotations
 
+import logging
 import pathlib
 import time
 
-from .api import make_stepper
-from .errors import SceneError, SolverError
+from .api import make_stepper, run_loop
+from .errors import OutputError, SceneError, SolverError
 from .output import RunWriter, centreline_png, checkpoint, quicklook_png
+from .output._validation import check_flag, check_resume_overwrite, check_run_options
+from .output.folder import check_folder, prepare_folder
 from .result import Result
-from .stepping import check_run, march
 
 __all__ = ["run_to_folder"]
 
+logger = logging.getLogger("femehl")
+
+
+def _reporter(log):
+    """``say(message)``: to the logger, and to ``log`` too if one was given."""
+    if log is not None and not callable(log):
+        raise SceneError(f"log must be a callable taking one string (or None), got {log!r}.")
+
+    def say(message: str) -> None:
+        logger.info(message)
+        if log is not None:
+            log(message)
+    return say
+
+
+def _check_resume_time(start, t_end: float, dt: float) -> None:
+    """The checkpoint's time is on the run's time grid and not past ``t_end``."""
+    k = round(start.t / dt)
+    if abs(k * dt - start.t) > 1e-9 * max(1.0, start.t):
+        raise SceneError(f"cannot resume at t = {start.t:g} with dt = {dt:g}: "
+                         "resume with the dt of the original run.")
+    if t_end < start.t - 1e-9 * max(1.0, start.t):
+        raise SceneError(f"t_end = {t_end:g} is before the checkpoint at t = {start.t:g}: "
+                         f"give t_end >= {start.t:g} to resume.")
+
+
+def _terms(scene, stepper, t_end: float) -> str:
+    eff = scene.effects(t_end)
+    info = getattr(stepper, "info", {}) or {}
+    return (f"femehl: method {stepper.method}, terms: squeeze={eff['squeeze']}, "
+            f"sliding={eff['sliding']}, elasticity={eff['elasticity']}, "
+            f"imposed_load={eff['imposed_load']}; "
+            + ", ".join(f"{k}={v}" for k, v in info.items()
+                        if k in ("mesh", "elements", "nodes", "unknowns", "half")))
+
+
+def _pictures(result: Result, folder: pathlib.Path) -> None:
+    """The PNGs of the states reached (a failure to draw does not hide the run's outcome)."""
+    if not result.states:
+        return
+    try:
+        centreline_png(result, folder / "centreline.png")
+        quicklook_png(result, folder / "fields.png")
+    except Exception as exc:           # noqa: BLE001 - pictures are a convenience
+        logger.warning("femehl: could not draw the PNGs in %s (%s: %s)", folder, type(exc).__name__, exc)
+
 
 def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every=10,
-                  progress=False, log=print, checkpoint_every=None, resume=False, **options) -> Result:
+                  progress=False, log=None, checkpoint_every=None, resume=False, overwrite=False,
+                  **options) -> Result:
     """Solve ``scene`` and write ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs.
 
     Parameters
@@ -35,74 +93,104 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
         Fields are kept and written every ``store_every`` steps (and at the end).
     progress : bool, default: False
         Show a tqdm progress bar.
-    log : callable, default: print
-        Where the one-line reports go.
+    log : callable, optional
+        Also given each report line (they go to the logger ``"femehl"`` in any case).
     checkpoint_every : int, optional
         Save the state to ``folder/checkpoint.npz`` every this many steps (default:
-        ``store_every``) and at the end (see :mod:`femehl.output.checkpoint`).
+        ``store_every``; 0: only at the end) and at the end (see
+        :mod:`femehl.output.checkpoint`).
     resume : bool, default: False
         Continue from ``folder/checkpoint.npz`` (same scene, method and mesh, else
-        SceneError): summary.csv is appended and the field series numbering goes on.
-        The returned Result starts at the checkpoint.
+        SceneError): summary.csv is appended and the field series numbering goes on
+        after the files present.  The returned Result starts at the checkpoint.
+    overwrite : bool, default: False
+        Replace a run already in ``folder`` (its femehl files are removed first; other
+        files are left alone).  Without it such a folder is refused with OutputError.
+    **options
+        Discretization options of the method (``mesh``, ``dr``, ``dtheta``, ...).
+
+    Raises
+    ------
+    SceneError, OutputError
+        A bad option or an unusable folder, before anything is written.
+    SolverError, KeyboardInterrupt
+        The run stopped: ``exc.result`` is the partial Result, the files stay readable.
     """
-    t_end, dt, nsteps = check_run(t_end, dt)
-    folder = pathlib.Path(folder)
+    t_end, dt, nsteps, store_every, every = check_run_options(t_end, dt, store_every, checkpoint_every)
+    resume, overwrite = check_resume_overwrite(resume, overwrite)
+    progress = check_flag("progress", progress)
+    say = _reporter(log)
+    folder = check_folder(folder, resume=resume, overwrite=overwrite)
     t0 = time.perf_counter()
     stepper = make_stepper(scene, method, **options)
-    info = getattr(stepper, "info", {})
-    eff = scene.effects(t_end)
-    log(f"femehl: method {stepper.method}, terms: squeeze={eff['squeeze']}, "
-        f"sliding={eff['sliding']}, elasticity={eff['elasticity']}, "
-        f"imposed_load={eff['imposed_load']}; "
-        + ", ".join(f"{k}={v}" for k, v in info.items() if k in ("mesh", "elements", "nodes", "unknowns", "half"))
-        + f"; set-up {time.perf_counter() - t0:.1f} s")
-    result = Result(scene=scene, method=stepper.method, disc=stepper.disc)
     params = checkpoint.run_params(scene, stepper, dt)
     start = None
     if resume:
         checkpoint.check_params(checkpoint.read_params(folder), params)
-        start = checkpoint.load_checkpoint(folder)
-        log(f"femehl: resuming from the checkpoint at t = {start.t:g} (step {start.step})")
+        start = checkpoint.load_checkpoint(folder, reference=stepper.initial_state())
+        _check_resume_time(start, t_end, dt)
+    say(_terms(scene, stepper, t_end) + f"; set-up {time.perf_counter() - t0:.1f} s")
+
+    # ---- everything is checked: from here on the folder is written ----
+    removed = prepare_folder(folder, overwrite=overwrite)
+    if removed:
+        say(f"femehl: overwrite: removed {len(removed)} file(s) of the earlier run in {folder}")
+    if resume:
+        say(f"femehl: resuming from the checkpoint at t = {start.t:g} (step {start.step})")
+        if t_end <= start.t + 1e-9 * max(1.0, start.t):
+            say(f"femehl: the run in {folder} is already at t_end = {t_end:g}: nothing to do "
+                "(give a larger t_end to go on)")
         writer = checkpoint.resume_writer(folder, stepper.disc, store_every, start.t)
     else:
         writer = RunWriter(folder, stepper.disc, every=store_every)
-    checkpoint.write_params(folder, params)
-    every = store_every if checkpoint_every is None else checkpoint_every
-    if isinstance(every, bool) or not isinstance(every, int) or every < 0:
-        raise SceneError(f"checkpoint_every must be an integer >= 0, got {checkpoint_every!r}.")
+        checkpoint.write_params(folder, params)
     bar = None
     if progress:
         from tqdm import tqdm
-        bar = tqdm(total=nsteps, unit="step", desc=f"femehl {stepper.method}", leave=True)
-    last = None
+        done = 0 if start is None else round(start.t / dt)
+        bar = tqdm(total=nsteps, initial=done, unit="step", desc=f"femehl {stepper.method}", leave=True)
+    last = {"state": None, "saved": None}
+
+    def on_state(state):
+        try:
+            writer(state)
+            last["state"] = state
+            if every and state.step % every == 0:
+                checkpoint.save_checkpoint(folder, state)
+                last["saved"] = state
+        except OSError as exc:
+            raise OutputError(f"cannot write into {str(folder)!r} at t = {state.t:g} "
+                              f"({exc.strerror or exc}): free space or fix permissions, then resume "
+                              "(resume=True, --resume).") from exc
+        if bar is not None and state.step:
+            bar.update(1)
+            bar.set_postfix(t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}",
+                            refresh=False)
+
+    result = None
+    finished = False
     try:
-        for state in march(stepper, t_end, dt, start=start):
-            keep = bool(store_every) and state.step % store_every == 0
-            result.record(state, store_fields=keep)
-            if state is not start:              # a resumed run's first state is already written
-                writer(state)
-                if every and state.step % every == 0:
-                    checkpoint.save_checkpoint(folder, state)
-            last = (state, keep)
-            if bar is not None and state.step:
-                bar.update(1)
-                bar.set_postfix(t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}", refresh=False)
+        result = run_loop(stepper, t_end, dt, start=start, store_every=store_every, on_state=on_state)
+        finished = True
     except SolverError as exc:
-        exc.result = result
-        log(f"femehl: run stopped at t = {exc.t}: {exc}\n"
-            f"femehl: output up to t = {result.t[-1]:g} is in {folder}")
+        result = getattr(exc, "result", None)
+        say(f"femehl: run stopped at t = {exc.t}: {exc}")
+        raise
+    except KeyboardInterrupt as exc:
+        result = getattr(exc, "result", None)
+        say("femehl: interrupted")
         raise
     finally:
         if bar is not None:
             bar.close()
-        writer.close()
-        if last is not None and last[0] is not start:
-            checkpoint.save_checkpoint(folder, last[0])      # the last good state
-        if last is not None and store_every and not last[1]:
-            result._stored.append(last[0])
-        result.info.update(info)
-        result.info["wall_s"] = time.perf_counter() - t0
-        if result.states:
-            centreline_png(result, folder / "centreline.png")
-            quicklook_png(result, folder / "fields.png")
+        writer.close()                                   # the last state's fields, CSV closed
+        state = last["state"]
+        if state is not None and state is not last["saved"]:
+            checkpoint.save_checkpoint(folder, state)    # the last good state
+        if result is not None:
+            result.info["wall_s"] = time.perf_counter() - t0
+            _pictures(result, folder)
+        if state is not None and not finished:
+            say(f"femehl: output up to t = {state.t:g} is in {folder}; the checkpoint is at "
+                f"t = {state.t:g}")
     return result

@@ -28,7 +28,7 @@ import pytest
 import femehl
 from femehl import presets
 from femehl.baseline import RelaxationStepper, mass_balance_residual
-from femehl.errors import (FilmRuptureError, RelaxationDivergedError, SceneError, SingularSystemError,
+from femehl.errors import (CheckpointError, FilmRuptureError, RelaxationDivergedError, SceneError, SingularSystemError,
                            SolverError)
 from femehl.output.checkpoint import load_checkpoint
 from femehl.run import run_to_folder
@@ -254,7 +254,8 @@ def test_resume_reproduces_an_uninterrupted_run(tmp_path):
 
 
 def test_resume_after_a_run_that_went_past_its_checkpoint(tmp_path):
-    """A run killed after its last checkpoint: rows and fields past it are cut, then redone."""
+    """A run killed after its last checkpoint: rows past it are cut and redone; its field
+    files past it stay on disk untouched (out of the index) and the new ones get new numbers."""
     sc = presets.paper_sphere()
     a, b = tmp_path / "a", tmp_path / "b"
     run_to_folder(sc, a, t_end=0.7, checkpoint_every=2, **RUN)
@@ -262,10 +263,17 @@ def test_resume_after_a_run_that_went_past_its_checkpoint(tmp_path):
     run_to_folder(sc, b, t_end=0.3, **RUN)
     for f in ("checkpoint.npz", "checkpoint.json"):
         (a / f).write_bytes((b / f).read_bytes())
+    before = {p.name: p.read_bytes() for p in a.glob("fields_*.vtu")}
+    assert len(before) == 4                                   # t = 0, 0.3, 0.6, 0.7
     run_to_folder(sc, a, t_end=0.7, resume=True, **RUN)
     ts = [float(r[0]) for r in _summary_rows(a)[1:]]
     assert ts == pytest.approx([0.1 * k for k in range(8)])
-    _check_series(a)
+    assert {n: (a / n).read_bytes() for n in before} == before
+    root = ET.parse(a / "fields.pvd").getroot()
+    names = [ds.get("file") for ds in root.iter("DataSet")]
+    times = [float(ds.get("timestep")) for ds in root.iter("DataSet")]
+    assert names == ["fields_000000.vtu", "fields_000001.vtu", "fields_000004.vtu", "fields_000005.vtu"]
+    assert times == pytest.approx([0.0, 0.3, 0.6, 0.7])
 
 
 @pytest.mark.parametrize("change, where", [
@@ -288,7 +296,7 @@ def test_resume_refuses_a_different_run(tmp_path, change, where):
 
 
 def test_resume_without_checkpoint(tmp_path):
-    with pytest.raises(SceneError, match="no checkpoint"):
+    with pytest.raises(CheckpointError, match="no checkpoint"):
         run_to_folder(presets.paper_sphere(), tmp_path, t_end=0.1, resume=True, **RUN)
 
 

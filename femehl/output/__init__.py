@@ -3,18 +3,33 @@
 Nothing here steps a solver.  :class:`RunWriter` is the callback a run
 hands each State to, so files appear while the run goes; :func:`write_all`
 writes the same from a finished :class:`~femehl.result.Result`.
+:mod:`femehl.output.folder` decides whether a folder may be written (it
+refuses one that holds another run unless asked to overwrite or resume), and
+:mod:`femehl.output._validation` checks run and command-line options first.
 """
 
 from __future__ import annotations
 
 import pathlib
 
+from .folder import check_folder, prepare_folder
 from .plots import centreline_png, profile_times, quicklook_png
 from .series import SeriesWriter
 from .table import COLUMNS, SummaryWriter, write_summary
 
-__all__ = ["RunWriter", "write_all", "SeriesWriter", "SummaryWriter", "centreline_png",
-           "quicklook_png", "write_summary", "COLUMNS", "profile_times"]
+__all__ = [
+    "COLUMNS",
+    "RunWriter",
+    "SeriesWriter",
+    "SummaryWriter",
+    "centreline_png",
+    "check_folder",
+    "prepare_folder",
+    "profile_times",
+    "quicklook_png",
+    "write_all",
+    "write_summary",
+]
 
 
 class RunWriter:
@@ -26,13 +41,17 @@ class RunWriter:
     disc : discretization of the run (``stepper.disc``)
     every : int, default: 10
         Write the field series every ``every`` steps (0: never).
+    summary, series : SummaryWriter, SeriesWriter, optional
+        Writers to use instead of new ones (a resumed run appends to its files).
     """
 
-    def __init__(self, folder, disc, every: int = 10):
+    def __init__(self, folder, disc, every: int = 10, *, summary=None, series=None):
         self.folder = pathlib.Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
-        self.summary = SummaryWriter(self.folder / "summary.csv")
-        self.series = SeriesWriter(self.folder, disc) if every else None
+        self.summary = summary if summary is not None else SummaryWriter(self.folder / "summary.csv")
+        if series is None and every:
+            series = SeriesWriter(self.folder, disc)
+        self.series = series
         self.every = every
         self.last = None
 
@@ -49,10 +68,15 @@ class RunWriter:
         self.summary.close()
 
 
-def write_all(result, folder) -> pathlib.Path:
-    """Summary CSV, centreline PNG, quick-look PNG and VTK series of a finished Result."""
-    folder = pathlib.Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+def write_all(result, folder, *, overwrite: bool = False) -> pathlib.Path:
+    """Summary CSV, centreline PNG, quick-look PNG and VTK series of a finished Result.
+
+    The folder is checked first (:func:`~femehl.output.folder.check_folder`): a path that
+    is a file or not writable, or a folder holding another run, is refused with
+    :class:`~femehl.errors.OutputError`; ``overwrite=True`` replaces that run's files.
+    """
+    folder = check_folder(folder, overwrite=overwrite)
+    prepare_folder(folder, overwrite=overwrite)
     write_summary(result, folder / "summary.csv")
     series = SeriesWriter(folder, result.disc)
     for s in result.states:

@@ -15,7 +15,13 @@ run killed at any moment leaves the previous checkpoint intact.
 :func:`check_params` has confirmed that scene, method and discretization
 are the same.  :func:`resume_writer` reopens the summary CSV for appending
 (rows past the checkpoint, from a run that went on after it, are cut off)
-and the field series with its numbering continued.
+and the field series with its numbering continued after the highest-numbered
+.vtu present: field files already written are never overwritten, and the
+index is rebuilt from the files themselves if the .pvd is damaged or missing.
+
+A checkpoint that cannot be used (unreadable, truncated, missing entries, arrays
+that do not fit the discretization) raises :class:`~femehl.errors.CheckpointError`
+naming the file and what to do.
 """
 
 from __future__ import annotations
@@ -23,18 +29,33 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 import os
 import pathlib
-import xml.etree.ElementTree as ET
+import zipfile
+import zlib
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import CheckpointError, SceneError
 from ..stepping import State
 
-__all__ = ["CHECKPOINT", "PARAMS", "save_checkpoint", "load_checkpoint", "run_params",
-           "check_params", "resume_writer", "describe"]
+logger = logging.getLogger("femehl")
+
+__all__ = [
+    "CHECKPOINT",
+    "PARAMS",
+    "check_params",
+    "check_state",
+    "describe",
+    "load_checkpoint",
+    "read_params",
+    "resume_writer",
+    "run_params",
+    "save_checkpoint",
+    "write_params",
+]
 
 CHECKPOINT = "checkpoint.npz"
 PARAMS = "checkpoint.json"
@@ -42,6 +63,9 @@ FORMAT = 1
 
 _ARRAYS = ("p", "w", "d")
 _SCALARS = ("step", "t", "hc", "V", "load", "film_center", "film_min", "p_max")
+_KEYS = _ARRAYS + _SCALARS + ("film_min_at", "p_max_at", "has_prev", "d_prev", "dt_prev")
+_FIX = ("restore an intact copy of it, or start the run again with overwrite=True (--overwrite) "
+        "or in another folder (--out)")
 
 
 def _atomic_write(path: pathlib.Path, write):
@@ -70,28 +94,73 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     return path
 
 
-def load_checkpoint(folder) -> State:
-    """The State saved in ``folder/checkpoint.npz`` (SceneError if there is none or it is unreadable)."""
+def _bad(path, why: str) -> CheckpointError:
+    return CheckpointError(f"cannot resume from the checkpoint {str(path)!r}: {why}; {_FIX}.")
+
+
+def _scalar(a: dict, key: str, path, kind=float):
+    v = a[key]
+    if v.size != 1:
+        raise _bad(path, f"its entry {key!r} is not a single value (shape {v.shape})")
+    return kind(v.reshape(()).item())
+
+
+def load_checkpoint(folder, reference: State | None = None) -> State:
+    """The State saved in ``folder/checkpoint.npz``.
+
+    ``reference`` (e.g. ``stepper.initial_state()``) gives the array sizes the run
+    needs.  CheckpointError if the file is missing, unreadable, lacks entries or does
+    not fit.
+    """
     path = pathlib.Path(folder) / CHECKPOINT
     if not path.is_file():
-        raise SceneError(f"no checkpoint in {str(path.parent)!r} ({CHECKPOINT} is missing): "
-                         "run without resume first, or give the folder of the run to continue.")
+        raise CheckpointError(f"no checkpoint in {str(path.parent)!r} ({CHECKPOINT} is missing): "
+                              "run without resume first, or give the folder of the run to continue.")
     try:
         with np.load(path, allow_pickle=False) as z:
+            if not hasattr(z, "files"):
+                raise _bad(path, "it is a single array, not a femehl checkpoint")
             a = {k: z[k] for k in z.files}
-        has_prev = bool(a["has_prev"])
-        dt_prev = float(a["dt_prev"])
-        state = State(step=int(a["step"]), t=float(a["t"]), hc=float(a["hc"]), V=float(a["V"]),
-                      p=a["p"], w=a["w"], d=a["d"], load=float(a["load"]),
-                      film_center=float(a["film_center"]), film_min=float(a["film_min"]),
-                      film_min_at=tuple(a["film_min_at"].tolist()), p_max=float(a["p_max"]),
-                      p_max_at=tuple(a["p_max_at"].tolist()), info={"resumed": True},
-                      d_prev=a["d_prev"] if has_prev else None,
-                      dt_prev=None if math.isnan(dt_prev) else dt_prev)
-    except (OSError, ValueError, KeyError, TypeError, EOFError) as exc:
-        raise SceneError(f"cannot read the checkpoint {str(path)!r} ({type(exc).__name__}: {exc}); "
-                         "start the run again without resume.") from None
+    except CheckpointError:
+        raise
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, KeyError) as exc:
+        raise _bad(path, f"it is damaged or truncated ({type(exc).__name__}: {exc})") from None
+    missing = [k for k in _KEYS if k not in a]
+    if missing:
+        raise _bad(path, f"it lacks the entries {missing}")
+    try:
+        has_prev = _scalar(a, "has_prev", path, bool)
+        dt_prev = _scalar(a, "dt_prev", path)
+        floats = {k: _scalar(a, k, path) for k in _SCALARS if k != "step"}
+        arrays = {k: np.asarray(a[k], dtype=float) for k in _ARRAYS + ("film_min_at", "p_max_at", "d_prev")}
+        step = _scalar(a, "step", path, int)
+    except (TypeError, ValueError) as exc:
+        raise _bad(path, f"an entry has the wrong type ({exc})") from None
+    if step < 0 or not math.isfinite(floats["t"]) or floats["t"] < 0:
+        raise _bad(path, f"its step {step} / time {floats['t']} is not a time a run reaches")
+    state = State(step=step, t=floats["t"], hc=floats["hc"], V=floats["V"],
+                  p=arrays["p"], w=arrays["w"], d=arrays["d"], load=floats["load"],
+                  film_center=floats["film_center"], film_min=floats["film_min"],
+                  film_min_at=tuple(arrays["film_min_at"].tolist()), p_max=floats["p_max"],
+                  p_max_at=tuple(arrays["p_max_at"].tolist()), info={"resumed": True},
+                  d_prev=arrays["d_prev"] if has_prev else None,
+                  dt_prev=None if math.isnan(dt_prev) else dt_prev)
+    if reference is not None:
+        check_state(state, reference, path)
     return state
+
+
+def check_state(state: State, reference: State, path="checkpoint") -> None:
+    """CheckpointError unless ``state``'s arrays have the sizes of ``reference``'s and are finite."""
+    for k in _ARRAYS:
+        got, want = np.shape(getattr(state, k)), np.shape(getattr(reference, k))
+        if got != want:
+            raise _bad(path, f"its array {k!r} has shape {got}, the discretization needs {want}")
+        if not np.all(np.isfinite(getattr(state, k))):
+            raise _bad(path, f"its array {k!r} has non-finite values")
+    if state.d_prev is not None and np.shape(state.d_prev) != np.shape(reference.d):
+        raise _bad(path, f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
+                   f"the discretization needs {np.shape(reference.d)}")
 
 
 # ---- run parameters ------------------------------------------------------------------------
@@ -155,14 +224,22 @@ def write_params(folder, params: dict) -> pathlib.Path:
 
 
 def read_params(folder) -> dict:
+    """The run parameters saved beside the checkpoint (CheckpointError if unusable)."""
     path = pathlib.Path(folder) / PARAMS
     try:
-        return json.loads(path.read_text())
+        params = json.loads(path.read_text())
     except FileNotFoundError:
-        raise SceneError(f"no {PARAMS} next to the checkpoint in {str(path.parent)!r}: cannot check "
-                         "that the run to resume is the same; start it again without resume.") from None
+        raise CheckpointError(f"no {PARAMS} next to the checkpoint in {str(path.parent)!r}: cannot "
+                              f"check that the run to resume is the same; {_FIX}.") from None
     except (OSError, ValueError) as exc:
-        raise SceneError(f"cannot read {str(path)!r} ({exc}); start the run again without resume.") from None
+        raise CheckpointError(f"cannot read {str(path)!r} ({type(exc).__name__}: {exc}); {_FIX}.") from None
+    if not isinstance(params, dict):
+        raise CheckpointError(f"{str(path)!r} holds a JSON {type(params).__name__}, not the object of "
+                              f"run parameters femehl writes; {_FIX}.")
+    missing = [k for k in ("method", "scene", "discretization") if k not in params]
+    if missing:
+        raise CheckpointError(f"{str(path)!r} lacks the run parameters {missing}; {_FIX}.")
+    return params
 
 
 def _diff(a, b, where=""):
@@ -219,56 +296,32 @@ def _cut_summary(path: pathlib.Path, t_ckpt: float) -> None:
         fh.truncate(keep)
 
 
-def _series_entries(folder: pathlib.Path, stem: str, t_ckpt: float):
-    pvd = folder / f"{stem}.pvd"
-    if not pvd.is_file():
-        return []
-    try:
-        root = ET.parse(pvd).getroot()
-    except (ET.ParseError, OSError):
-        return []
+def _continue_series(writer, t_ckpt: float) -> None:
+    """Point a SeriesWriter at the files present: index up to ``t_ckpt``, numbering after all."""
+    from .series import scan_series
+
     tol = 1e-9 * max(1.0, abs(t_ckpt))
-    out = []
-    for ds in root.iter("DataSet"):
-        try:
-            t = float(ds.get("timestep"))
-        except (TypeError, ValueError):
-            continue
-        name = ds.get("file")
-        if name and t <= t_ckpt + tol and (folder / name).is_file():
-            out.append((t, name))
-    return out
+    found = scan_series(writer.folder, writer.stem)
+    writer.entries = sorted((t, name) for _, name, t in found if t is not None and t <= t_ckpt + tol)
+    writer.next_index = max((n for n, _, _ in found), default=-1) + 1
+    kept = [name for _, name, t in found if t is None or t > t_ckpt + tol]
+    if kept:
+        logger.info("femehl: kept %d field file(s) out of the index (past the checkpoint or of unknown "
+                    "time): %s", len(kept), ", ".join(kept[:5]) + (", ..." if len(kept) > 5 else ""))
+    writer._write_index()
 
 
 def resume_writer(folder, disc, every: int, t_ckpt: float):
     """A :class:`~femehl.output.RunWriter` that appends to the existing outputs of ``folder``."""
     from . import RunWriter
-    from .table import COLUMNS, SummaryWriter
+    from .series import SeriesWriter
+    from .table import SummaryWriter
 
     folder = pathlib.Path(folder)
     summary = folder / "summary.csv"
     _cut_summary(summary, t_ckpt)
-
-    class _Appending(SummaryWriter):
-        def __init__(self, path):          # open for appending; header only for a new file
-            import csv
-            self.path = pathlib.Path(path)
-            new = not self.path.is_file() or self.path.stat().st_size == 0
-            self._fh = open(self.path, "a", newline="")
-            self._csv = csv.writer(self._fh)
-            if new:
-                self._csv.writerow(COLUMNS)
-            self._fh.flush()
-
-    writer = RunWriter.__new__(RunWriter)
-    writer.folder = folder
-    writer.summary = _Appending(summary)
-    writer.every = every
-    writer.last = None
-    writer.series = None
+    series = None
     if every:
-        from .series import SeriesWriter
-        writer.series = SeriesWriter(folder, disc)
-        writer.series.entries = _series_entries(folder, writer.series.stem, t_ckpt)
-        writer.series._write_index()
-    return writer
+        series = SeriesWriter(folder, disc)
+        _continue_series(series, t_ckpt)
+    return RunWriter(folder, disc, every, summary=SummaryWriter(summary, append=True), series=series)

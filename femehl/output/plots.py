@@ -6,7 +6,7 @@ import pathlib
 
 import numpy as np
 
-__all__ = ["centreline_png", "quicklook_png", "profile_times"]
+__all__ = ["centreline_png", "profile_times", "quicklook_png"]
 
 
 def _plt():
@@ -53,7 +53,7 @@ def centreline_png(results, path, times=None, labels=None, L=None):
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (res, lab) in enumerate(zip(results, labels)):
         for i, t in enumerate(times):
-            kw = dict(color=colors[i % len(colors)], ls=styles[k % len(styles)])
+            kw = {"color": colors[i % len(colors)], "ls": styles[k % len(styles)]}
             ax1.plot(x, res.pressure_at(pts, t), label=f"{lab} t={t:g}", **kw)
             ax2.plot(x, res.film_at(pts, t), **kw)
     xh = np.linspace(-1, 1, 201)

@@ -7,18 +7,25 @@ rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
 normalized; z = 0.  A half-disk run is written as computed (y >= 0); use
 ParaView's Reflect filter (plane Y) to see the whole contact.
+
+Each .vtu is written atomically (temporary file + rename) and carries its time
+as ``TimeValue`` field data, so the index can be rebuilt from the files alone
+(:func:`scan_series`) if the .pvd is damaged or missing.  Files are numbered
+on from ``next_index``: a writer never reuses the name of a file present.
 """
 
 from __future__ import annotations
 
 import os
 import pathlib
+import re
+import xml.etree.ElementTree as ET
 from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
 
-__all__ = ["SeriesWriter", "grid_cells"]
+__all__ = ["SeriesWriter", "grid_cells", "read_index", "scan_series", "vtu_time"]
 
 
 def grid_cells(disc):
@@ -48,13 +55,14 @@ class SeriesWriter:
         self.stem = stem
         self.points, self.cells, self.on_nodes = grid_cells(disc)
         self.entries: list[tuple[float, str]] = []
+        self.next_index = 0                 # number of the next file (never one present)
 
     @property
     def pvd_path(self) -> pathlib.Path:
         return self.folder / f"{self.stem}.pvd"
 
     def write(self, state) -> pathlib.Path:
-        name = f"{self.stem}_{len(self.entries):06d}.vtu"
+        name = f"{self.stem}_{self.next_index:06d}.vtu"
         h = state.d + state.w
         if self.on_nodes:
             point_data = {"pressure": state.p, "film": state.d, "deflection": state.w, "gap": h}
@@ -65,7 +73,11 @@ class SeriesWriter:
         mesh = meshio.Mesh(self.points, self.cells, point_data=point_data, cell_data=cell_data,
                            field_data={"TimeValue": np.array([state.t])})
         path = self.folder / name
-        meshio.write(path, mesh, file_format="vtu", binary=True)
+        tmp = path.with_name(path.name + ".tmp")
+        meshio.write(tmp, mesh, file_format="vtu", binary=True)
+        _add_time_value(tmp, state.t)
+        os.replace(tmp, path)
+        self.next_index += 1
         self.entries.append((state.t, name))
         self._write_index()
         return path
@@ -80,3 +92,84 @@ class SeriesWriter:
         tmp = self.pvd_path.with_suffix(".pvd.tmp")
         tmp.write_text("\n".join(lines))
         os.replace(tmp, self.pvd_path)
+
+
+_GRID_TAG = b"<UnstructuredGrid>"
+_TIME_RE = re.compile(rb'Name="TimeValue"[^>]*>\s*([^<\s]+)\s*<')
+
+
+def _add_time_value(path: pathlib.Path, t: float) -> None:
+    """Put ``TimeValue`` field data in a .vtu (meshio's writer leaves field data out)."""
+    data = path.read_bytes()
+    block = (b'\n<FieldData>\n<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
+             b'format="ascii">' + repr(float(t)).encode() + b"</DataArray>\n</FieldData>")
+    i = data.find(_GRID_TAG)
+    if i >= 0:
+        i += len(_GRID_TAG)
+        path.write_bytes(data[:i] + block + data[i:])
+
+
+def _read_ends(path: pathlib.Path):
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+            fh.seek(max(0, path.stat().st_size - 64))
+            return head, fh.read()
+    except OSError:
+        return b"", b""
+
+
+def vtu_time(path) -> float | None:
+    """The ``TimeValue`` of a .vtu written here; None if absent or the file is not complete."""
+    head, tail = _read_ends(pathlib.Path(path))
+    m = _TIME_RE.search(head)
+    if m is None or not tail.rstrip().endswith(b"</VTKFile>"):
+        return None
+    try:
+        return float(m.group(1))
+    except ValueError:
+        return None
+
+
+def _complete(path: pathlib.Path) -> bool:
+    head, tail = _read_ends(path)
+    return head.startswith(b"<?xml") and tail.rstrip().endswith(b"</VTKFile>")
+
+
+def read_index(folder, stem: str = "fields") -> dict:
+    """``{file name: time}`` of the .pvd index; empty if it is missing or damaged."""
+    pvd = pathlib.Path(folder) / f"{stem}.pvd"
+    try:
+        root = ET.parse(pvd).getroot()
+    except (ET.ParseError, OSError):
+        return {}
+    out = {}
+    for ds in root.iter("DataSet"):
+        try:
+            t = float(ds.get("timestep"))
+        except (TypeError, ValueError):
+            continue
+        if ds.get("file"):
+            out[ds.get("file")] = t
+    return out
+
+
+def scan_series(folder, stem: str = "fields") -> list[tuple[int, str, float | None]]:
+    """The ``stem_NNNNNN.vtu`` files present as ``(number, name, time)``, by number.
+
+    The time is the file's own ``TimeValue``, else (a complete file without one) the
+    time the .pvd index gives it, else None: a damaged file or one of unknown time.
+    """
+    folder = pathlib.Path(folder)
+    pattern = re.compile(rf"{re.escape(stem)}_(\d+)\.vtu$")
+    index = read_index(folder, stem)
+    out = []
+    for path in folder.glob(f"{stem}_*.vtu"):
+        m = pattern.match(path.name)
+        if m is None or not path.is_file():
+            continue
+        t = vtu_time(path)
+        if t is None and _complete(path):             # written before files carried their time
+            t = index.get(path.name)
+        out.append((int(m.group(1)), path.name, t))
+    return sorted(out)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import pathlib
 
-__all__ = ["SummaryWriter", "COLUMNS"]
+__all__ = ["COLUMNS", "SummaryWriter"]
 
 COLUMNS = ("t", "hc", "V", "load", "film_center", "film_min", "film_min_x", "film_min_y",
            "p_max", "p_max_x", "p_max_y")
@@ -18,14 +18,20 @@ def _row(state):
 
 
 class SummaryWriter:
-    """Append one CSV row per State (normalized units) to ``path``; header first."""
+    """Write one CSV row per State (normalized units) to ``path``, flushed at once; header first.
 
-    def __init__(self, path):
+    ``append=True`` continues an existing file (the header is written only to a new or
+    empty one).
+    """
+
+    def __init__(self, path, append: bool = False):
         self.path = pathlib.Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._fh = open(self.path, "w", newline="")
+        new = not append or not self.path.is_file() or self.path.stat().st_size == 0
+        self._fh = open(self.path, "a" if append else "w", newline="")  # noqa: SIM115 - kept open
         self._csv = csv.writer(self._fh)
-        self._csv.writerow(COLUMNS)
+        if new:
+            self._csv.writerow(COLUMNS)
         self._fh.flush()
 
     def write(self, state):

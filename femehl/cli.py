@@ -13,8 +13,8 @@ Options that do not apply to the chosen method are refused.  The run's
 reports go to stderr (logger "femehl"), the figures reached to stdout.
 
 A scene file with ``[indenter] kind = "cylinder"`` is line contact (a
-:class:`femehl.line.LineScene`): it is run by :func:`femehl.line.solve_line`
-and writes summary.csv (same columns, y = 0) and line.png.
+:class:`femehl.line.LineScene`, method "line"): the same run folder (summary.csv with
+y = 0, the field series on the 1-D mesh, checkpoints) and line.png.
 """
 
 from __future__ import annotations
@@ -108,21 +108,21 @@ def _run(args, argv=()):
         scene, run = presets.paper_sphere(), {}
         name = "paper_sphere"
     from .line import LineScene
-    if isinstance(scene, LineScene):
-        return _run_line(scene, run, args, name)
-    if args.method == "line":
-        raise FemehlError("--method line is for line contact scenes ([indenter] kind = \"cylinder\"); "
-                          "use fe or fd for this scene.")
-    if args.n_elements is not None:
-        raise FemehlError("--n-elements is a line contact option ([indenter] kind = \"cylinder\"); "
-                          "with a 2-D scene give --mesh (fe) or --dr (fd) instead.")
+
+    is_line = isinstance(scene, LineScene)
     resume, overwrite = check_resume_overwrite(args.resume, args.overwrite)
     run = run_options(run)
-    method = args.method or run.pop("method", "fe")
+    method = args.method or run.pop("method", "line" if is_line else "fe")
     run.pop("method", None)
+    if is_line and method != "line":
+        raise FemehlError(f"--method {method} does not apply to line contact; its method is 'line' "
+                          "(leave --method out).")
+    if method == "line" and not is_line:
+        raise FemehlError("--method line is for line contact scenes ([indenter] kind = \"cylinder\"); "
+                          "use fe or fd for this scene.")
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
-    for key in ("scheme", "mesh", "dt", "t_end", "store_every"):
+    for key in ("scheme", "mesh", "n_elements", "dt", "t_end", "store_every"):
         v = getattr(args, key)
         if v is not None and not (key == "scheme" and method == "fd"):    # fd: euler, its own scheme
             run[key] = v
@@ -135,7 +135,7 @@ def _run(args, argv=()):
         # (coarser ones rupture at the exit: see the FD module docstring)
         run.setdefault("dr", 0.0125)
         run.setdefault("dtheta", math.pi / 36)
-    else:
+    elif method == "fe":
         run.setdefault("mesh", "medium")
     out = args.out or f"{DEFAULT_OUT}/{name}"
     try:
@@ -144,7 +144,11 @@ def _run(args, argv=()):
                             resume=resume, overwrite=overwrite, **run)
     except KeyboardInterrupt:
         return _interrupted(out, argv)
-    print(f"femehl: done in {res.info['wall_s']:.1f} s; wrote {out}/summary.csv, fields.pvd, centreline.png, fields.png")
+    from .output.plots import FIGURES
+
+    files = ", ".join(["fields.pvd"] + [name for name, _ in FIGURES[res.disc.dimension]])
+    print(f"femehl: done in {res.info['wall_s']:.1f} s ({res.info['unknowns']} unknowns, "
+          f"{res.nsteps} steps); wrote {out}/summary.csv, {files}")
     if dim is not None:
         print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
     for t in sorted({1.0, float(res.t[-1])}):
@@ -170,92 +174,6 @@ class _SummaryFile:
             rows = list(csv.reader(fh))
         head, body = rows[0], np.array(rows[1:], dtype=float).reshape(-1, len(rows[0]))
         return {c: body[:, i] for i, c in enumerate(head)}
-
-
-def _run_line(scene, run, args, name):
-    """Line contact: :func:`femehl.line.solve_line`, summary.csv and line.png in the output folder."""
-    import pathlib
-    import time
-
-    import numpy as np
-
-    from .line import solve_line
-    from .output.table import SummaryWriter
-
-    bad = [opt for opt, key in (("--mesh", "mesh"), ("--dr", "dr"),
-                                ("--dtheta-divisions", "dtheta_divisions"), ("--resume", "resume"))
-           if getattr(args, key) not in (None, False)]
-    if bad:
-        raise FemehlError(f"{', '.join(bad)} do(es) not apply to line contact (1-D mesh of "
-                          "[-L, L]); give --n-elements (and [run] grading) instead.")
-    if args.method not in (None, "line"):
-        raise FemehlError(f"--method {args.method} does not apply to line contact; "
-                          "its solver is 'line' (leave --method out).")
-    run = dict(run)
-    for key in ("scheme", "dt", "t_end", "store_every", "n_elements"):
-        v = getattr(args, key)
-        if v is not None:
-            run[key] = v
-    t_end, dt = run.pop("t_end", 5.0), run.pop("dt", 0.01)
-    store_every = run.pop("store_every", 10)
-    out = pathlib.Path(args.out or f"{DEFAULT_OUT}/{name}")
-    out.mkdir(parents=True, exist_ok=True)
-    ts = np.linspace(0.0, t_end, 2001) if t_end > 0 else np.zeros(1)
-    sq = scene.imposed_load or any(scene.motion.hc(t) != scene.motion.hc(0.0) for t in ts)
-    sl = any(scene.motion.V(t) != 0.0 for t in ts)
-    n_steps = max(1, math.ceil(t_end / dt - 1e-9)) if dt > 0 and t_end > 0 else 0
-    every = max(1, n_steps // 20) if n_steps else 1
-    t0 = time.perf_counter()
-
-    def progress(s):
-        if not args.quiet and s.step and (s.step % every == 0):
-            print(f"  step {s.step}: t = {s.t:.4g}, load {s.load:.5g}, minimum film {s.film_min:.5g}",
-                  flush=True)
-
-    with SummaryWriter(out / "summary.csv") as writer:
-        def callback(s):
-            writer.write(s)
-            progress(s)
-        print(f"femehl: method line, terms: squeeze={sq}, sliding={sl}, elasticity=winkler, "
-              f"imposed_load={scene.imposed_load}; k={scene.k:g}, beta={scene.beta:g}, L={scene.L:g}")
-        res = solve_line(scene, t_end, dt, store_every=store_every, callback=callback, **run)
-    png = _line_png(res, out / "line.png")
-    print(f"femehl: done in {time.perf_counter() - t0:.1f} s ({res.info['elements']} elements, "
-          f"{res.info['steps']} steps); wrote {out}/summary.csv, {png.name}")
-    for t in sorted({1.0, float(res.t[-1])}):
-        if t <= res.t[-1] + 1e-9:
-            val = {c: float(np.interp(t, res.t, getattr(res, c)))
-                   for c in ("load", "film_center", "film_min")}
-            print(f"  t = {t:g}: load {val['load']:.5g}, central film {val['film_center']:.5g}, "
-                  f"minimum film {val['film_min']:.5g}")
-    return 0
-
-
-def _line_png(res, path):
-    """p(x) and d(x) at a few stored times of a line-contact run."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    states = list(res.states[:: max(1, len(res.states) // 6)])
-    if states[-1] is not res.final:
-        states.append(res.final)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
-    for i, s in enumerate(states):
-        last = s is res.final
-        kw = dict(lw=2 if last else 0.8, alpha=1.0 if last else 0.6, label=f"t = {s.t:.3g}")
-        ax1.plot(res.disc.x, s.p, **kw)
-        ax2.plot(res.disc.xc, s.d, **kw)
-    ax1.set_ylabel("p")
-    ax2.set_ylabel("d")
-    ax2.set_xlabel("x  (cylinder slides toward +x)")
-    ax1.legend(fontsize=7, ncol=2)
-    sc = res.scene
-    fig.suptitle(f"cylinder on Winkler foundation: k = {sc.k:g}, beta = {sc.beta:g}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
 
 
 def _write_si_summary(dim, result, out):

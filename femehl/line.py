@@ -8,7 +8,7 @@ substrate a Winkler foundation ``w = -p/k``, and the film thickness
     d(x, t) = hc(t) + x^2/2 + p(x, t)/k           (d = h - w, w < 0 under p > 0)
 
 obeys the 1-D normalized Reynolds equation, with the same conventions as the
-2-D problem of :mod:`femehl.scene` (design.md sections 1-2):
+2-D problem of :mod:`femehl.scene` (docs/design.md, sections 1-2):
 
     beta d/dx( d^3 dp/dx ) = -V(t) dd/dx + dd/dt      on -L < x < L,
     p(-L) = p(L) = 0,    p(x, 0) = 0  so  d(x, 0) = hc(0) + x^2/2.
@@ -21,7 +21,7 @@ problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
 steady sliding solution, which :mod:`femehl.line_steady` computes by
 quadrature and shooting.
 
-The scheme (paper section 3, femehl's FE form, design.md section 4)
+The scheme (paper section 3, femehl's FE form, docs/design.md, section 4)
 ------------------------------------------------------------------
 P1 pressure on a scikit-fem :class:`~skfem.MeshLine` (uniform or graded),
 the film on elements (P0): ``d_e = h(x_e) + (P p)_e / k`` with ``x_e`` the
@@ -63,8 +63,8 @@ from typing import Callable
 import numpy as np
 
 from .errors import SceneError
-from .scene import (Constant, Fluid, Motion, RampHold, Table, _as_time_function, TanhStart,
-                    check_finite, check_positive)
+from .scene import (Constant, Fluid, Motion, RampHold, SceneEffects, Table, TanhStart,
+                    _as_time_function, check_finite, check_positive)
 from .stepping import State
 from .substrates import Winkler
 
@@ -79,7 +79,7 @@ def _default_motion() -> Motion:
 # scene
 # --------------------------------------------------------------------------
 @dataclass(frozen=True)
-class LineScene:
+class LineScene(SceneEffects):
     """A rigid cylinder (gap ``x^2/2``) on a lubricated Winkler foundation, normalized.
 
     Parameters

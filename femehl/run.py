@@ -24,7 +24,7 @@ import time
 
 from .api import make_stepper, run_loop
 from .errors import OutputError, SceneError, SolverError
-from .output import RunWriter, centreline_png, checkpoint, quicklook_png
+from .output import RunWriter, checkpoint, draw_figures
 from .output._validation import check_flag, check_resume_overwrite, check_run_options
 from .output.folder import check_folder, prepare_folder
 from .result import Result
@@ -72,8 +72,7 @@ def _pictures(result: Result, folder: pathlib.Path) -> None:
     if not result.states:
         return
     try:
-        centreline_png(result, folder / "centreline.png")
-        quicklook_png(result, folder / "fields.png")
+        draw_figures(result, folder)
     except Exception as exc:           # noqa: BLE001 - pictures are a convenience
         logger.warning("femehl: could not draw the PNGs in %s (%s: %s)", folder, type(exc).__name__, exc)
 

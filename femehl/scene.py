@@ -279,8 +279,32 @@ class Domain:
         object.__setattr__(self, "L", check_positive("Domain radius L", self.L))
 
 
+class SceneEffects:
+    """What a scene calls for over a run: shared by :class:`Scene` and ``LineScene``."""
+
+    def has_sliding(self, t_end: float, n: int = 2001) -> bool:
+        ts = np.linspace(0.0, t_end, n)
+        return any(self.motion.V(t) != 0.0 for t in ts)
+
+    def has_squeeze(self, t_end: float, n: int = 2001) -> bool:
+        if self.motion.load_controlled:
+            return True
+        ts = np.linspace(0.0, t_end, n)
+        h = [self.motion.hc(t) for t in ts]
+        return max(h) != min(h)
+
+    def effects(self, t_end: float) -> dict:
+        """The terms the solver must assemble for a run to ``t_end``."""
+        return {
+            "squeeze": self.has_squeeze(t_end),
+            "sliding": self.has_sliding(t_end),
+            "elasticity": self.substrate.kind,
+            "imposed_load": self.motion.load_controlled,
+        }
+
+
 @dataclass(frozen=True)
-class Scene:
+class Scene(SceneEffects):
     """Everything a solver needs to know about the physics, in normalized units."""
 
     indenter: Sphere = field(default_factory=Sphere)
@@ -551,26 +575,6 @@ class Scene:
         t_hi = max([t_hi] + extra)
         return np.unique(np.concatenate([np.linspace(0.0, t_hi, 1001), extra]))
 
-    # ---- what the scene calls for (design.md section 6) -------------------
-    def has_sliding(self, t_end: float, n: int = 2001) -> bool:
-        ts = np.linspace(0.0, t_end, n)
-        return any(self.motion.V(t) != 0.0 for t in ts)
-
-    def has_squeeze(self, t_end: float, n: int = 2001) -> bool:
-        if self.motion.load_controlled:
-            return True
-        ts = np.linspace(0.0, t_end, n)
-        h = [self.motion.hc(t) for t in ts]
-        return max(h) != min(h)
-
-    def effects(self, t_end: float) -> dict:
-        """The terms the solver must assemble for a run to ``t_end``."""
-        return {
-            "squeeze": self.has_squeeze(t_end),
-            "sliding": self.has_sliding(t_end),
-            "elasticity": self.substrate.kind,
-            "imposed_load": self.motion.load_controlled,
-        }
 
 
 # --------------------------------------------------------------------------

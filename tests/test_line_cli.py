@@ -33,10 +33,12 @@ def test_cli_runs_line_contact(tmp_path, capsys):
     out = tmp_path / "out"
     rc = main(["run", str(TOML), "--t-end", "2", "--dt", "0.05", "--out", str(out), "--quiet"])
     assert rc == 0
-    text = capsys.readouterr().out
+    cap = capsys.readouterr()
+    text = cap.out + cap.err          # the run's report goes to stderr, the figures to stdout
     assert "elasticity=winkler" in text and "sliding=True" in text and "squeeze=True" in text
     assert "t = 1:" in text and "t = 2:" in text
     assert (out / "line.png").stat().st_size > 0
+    assert (out / "fields.pvd").is_file() and (out / "checkpoint.npz").is_file()   # a run folder
     with open(out / "summary.csv", newline="") as fh:
         rows = list(csv.reader(fh))
     assert tuple(rows[0]) == COLUMNS
@@ -96,7 +98,8 @@ def test_unknown_run_key_is_refused(tmp_path, capsys):
 def test_2d_options_are_refused(tmp_path, capsys, extra):
     rc = main(["run", str(TOML), "--t-end", "0.1", "--out", str(tmp_path / "o"), "--quiet"] + extra)
     assert rc == 2
-    assert "line contact" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "line contact" in err
 
 
 def test_radius_other_than_one_is_refused(tmp_path):

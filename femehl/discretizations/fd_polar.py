@@ -104,6 +104,7 @@ class FDDisc:
         Azimuthal step (pi/dtheta must be an integer).
     """
 
+    dimension = 2
     default_linear_solver = "lu"
 
     def __init__(self, scene, dr: float = 0.0125, dtheta: float = math.pi / 36):

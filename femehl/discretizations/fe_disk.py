@@ -48,6 +48,7 @@ class FEDisc:
         Use the half disk y >= 0; default: True when the indenter is symmetric in y.
     """
 
+    dimension = 2
     default_linear_solver = "gmres"
 
     def __init__(self, scene, mesh="medium", half: bool | None = None):

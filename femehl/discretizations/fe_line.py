@@ -44,6 +44,7 @@ class LineDisc:
         contact half width (:meth:`LineScene.contact_halfwidth`), or ``L/2``.
     """
 
+    dimension = 1
     default_linear_solver = "lu"
 
     def __init__(self, scene, n_elements: int = 400, grading=3.0, fine=None):

@@ -13,7 +13,7 @@ from __future__ import annotations
 import pathlib
 
 from .folder import check_folder, prepare_folder
-from .plots import centreline_png, profile_times, quicklook_png
+from .plots import centreline_png, draw_figures, line_png, profile_times, quicklook_png
 from .series import SeriesWriter
 from .table import COLUMNS, SummaryWriter, write_summary
 
@@ -23,6 +23,8 @@ __all__ = [
     "SeriesWriter",
     "SummaryWriter",
     "centreline_png",
+    "draw_figures",
+    "line_png",
     "check_folder",
     "prepare_folder",
     "profile_times",
@@ -82,6 +84,5 @@ def write_all(result, folder, *, overwrite: bool = False) -> pathlib.Path:
     for s in result.states:
         series.write(s)
     if result.states:
-        centreline_png(result, folder / "centreline.png")
-        quicklook_png(result, folder / "fields.png")
+        draw_figures(result, folder)
     return folder

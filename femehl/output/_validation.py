@@ -80,10 +80,15 @@ def check_step(name: str, value) -> float:
 #: command-line flags that only one method understands (argparse dest -> flag, methods)
 METHOD_FLAGS = {
     "mesh": ("--mesh", ("fe",)),
-    "scheme": ("--scheme", ("fe",)),
+    "scheme": ("--scheme", ("fe", "line")),
     "dr": ("--dr", ("fd",)),
     "dtheta_divisions": ("--dtheta-divisions", ("fd",)),
+    "n_elements": ("--n-elements", ("line",)),
 }
+
+
+#: what to say instead of "use another method" where the scene fixes the method
+METHOD_HINTS = {"line": " (line contact is a 1-D mesh of [-L, L]: give --n-elements instead)"}
 
 
 def check_method_flags(method: str, given: dict) -> None:
@@ -101,6 +106,8 @@ def check_method_flags(method: str, given: dict) -> None:
             continue
         bad.append(flag)
     if bad:
-        other = {"fe": "fd", "fd": "fe"}.get(method, "fe")
+        users = sorted({m for key, value in given.items() if value is not None and key in METHOD_FLAGS
+                        for m in METHOD_FLAGS[key][1]} - {method})
+        hint = METHOD_HINTS.get(method) or (f" or use --method {' / '.join(users)}" if users else "")
         raise SceneError(f"{', '.join(bad)} do(es) not apply to --method {method}: drop "
-                         f"{'them' if len(bad) > 1 else 'it'} or use --method {other}.")
+                         f"{'them' if len(bad) > 1 else 'it'}{hint}.")

@@ -18,7 +18,7 @@ __all__ = ["RUN_FILES", "check_folder", "clear_run_files", "prepare_folder", "ru
 
 #: the files a femehl run writes into its folder (besides the field series fields_NNNNNN.vtu)
 RUN_FILES = ("summary.csv", "summary_si.csv", "fields.pvd", "checkpoint.npz", "checkpoint.json",
-             "centreline.png", "fields.png")
+             "centreline.png", "fields.png", "line.png")
 _SERIES = re.compile(r"fields_\d+\.vtu$")
 _TEMPORARY = re.compile(r"(fields\.pvd|checkpoint\.npz|checkpoint\.json|fields_\d+\.vtu)\.tmp$")
 

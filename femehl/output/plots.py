@@ -93,3 +93,38 @@ def quicklook_png(result, path, t=None):
         ax.set_title(f"{name} at t = {state.t:g}")
         ax.set_xlabel("x")
     return _save(plt, fig, path, dpi=100)
+
+
+def line_png(result, path):
+    """p(x) and d(x) at a few stored times of a line-contact run."""
+    plt = _plt()
+    states = list(result.states[:: max(1, len(result.states) // 6)])
+    if states[-1] is not result.final:
+        states.append(result.final)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
+    for s in states:
+        last = s is result.final
+        kw = {"lw": 2 if last else 0.8, "alpha": 1.0 if last else 0.6, "label": f"t = {s.t:.3g}"}
+        ax1.plot(result.disc.x, s.p, **kw)
+        ax2.plot(result.disc.xc, s.d, **kw)
+    ax1.set_ylabel("p")
+    ax2.set_ylabel("d")
+    ax2.set_xlabel("x  (cylinder slides toward +x)")
+    ax1.legend(fontsize=7, ncol=2)
+    sc = result.scene
+    fig.suptitle(f"cylinder on Winkler foundation: k = {sc.k:g}, beta = {sc.beta:g}")
+    return _save(plt, fig, path, 110)
+
+
+#: the figures of a run folder, by the dimension of the discretization: (file name, drawer)
+FIGURES = {1: (("line.png", line_png),),
+           2: (("centreline.png", centreline_png), ("fields.png", quicklook_png))}
+
+
+def draw_figures(result, folder):
+    """Draw the figures of ``result`` into ``folder``; returns their paths."""
+    out = []
+    for name, draw in FIGURES[result.disc.dimension]:
+        draw(result, pathlib.Path(folder) / name)
+        out.append(pathlib.Path(folder) / name)
+    return out

@@ -1,4 +1,4 @@
-"""What accuracy costs: error against wall time for the FE and FD solvers (issue 6).
+"""What accuracy costs: error against wall time for the FE and FD solvers.
 
     femehl bench accuracy [--quick] [--out DIR] [--resume] [--analyze-only]
                           [--part study|timestep|all] [--fd-extra]

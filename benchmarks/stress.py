@@ -132,7 +132,7 @@ class OscillationTracker:
         if self.t_first is None:
             self.t_first = t
         self.t_last = t
-        # film_min (the measure)
+        # film_min (the oscillation measure)
         s = int(np.sign(dmin)) if abs(dmin) > NOISE * abs(film_min) else 0
         if s and self.prev_dmin_sign and s != self.prev_dmin_sign:
             self.min_changes += 1
@@ -429,7 +429,7 @@ documented FilmRuptureError naming time and place; none crashed.  They fall in t
    resolutions, stopped with the documented error rather than continued with a negative
    film.
 
-The issue's oscillation measure (sign changes of the change of the minimum film,
+The oscillation measure (sign changes of the change of the minimum film,
 osc_min_per_t) reaches 20-33 per unit time in the beta = 2-20, h0 = 0.01 cases: the
 minimum hops between neighbouring elements while the trapped pocket's rim travels
 through the exit (each element's film stays smooth: sawtooth <= 2), so it is reported

@@ -3,7 +3,7 @@
 The load F = 4/(3 pi) (the normalized Hertz load of an indentation hc = -1) is applied
 at t = 0 to the paper's sphere (beta = 200, hc(0) = 0.1, incompressible half space).
 The tip clearance hc(t) is then an unknown: every step solves ONE linear system with
-one extra row, int p dA = F (design.md section 6).  The sphere sinks fast, then slowly,
+one extra row, int p dA = F (docs/design.md, section 6).  The sphere sinks fast, then slowly,
 toward the Hertz depth hc = -1 while the trapped film drains.
 
 Run::

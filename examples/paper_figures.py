@@ -5,7 +5,7 @@ h0 = 0.1):
 
 * Fig. 5, transient normal indentation: t = 0.5, 0.8, 1.0;
 * Fig. 6, transient sliding: t = 1.0, 1.5, 2.0 (exit constriction near x = -1);
-* Fig. 7, the long-time state at t = t_end (5 in the paper; design.md s. 7: at
+* Fig. 7, the long-time state at t = t_end (5 in the paper; docs/design.md, section 7: at
   t = 5 the films are still ~1 % from steady).
 
 FE: the default solver on the given ladder mesh.  FD: the paper's polar

@@ -1,7 +1,7 @@
 """Frozen descriptions of a soft-EHL problem: indenter, substrate, fluid, motion, domain.
 
-Conventions (design.md sections 1-2; Wu, Hui et al., JMPS 2022, Eqs. 8, 10, 12)
-------------------------------------------------------------------------------
+Conventions (docs/design.md, sections 1-2; Wu, Hui et al., JMPS 2022, Eqs. 8, 10, 12)
+-------------------------------------------------------------------------------------
 Everything in a :class:`Scene` is in the paper's normalized variables::
 
     r = r*/sqrt(R h_inf)     t = V_ss t*/(2 sqrt(R h_inf))
@@ -493,7 +493,7 @@ class Scene:
         t_hi = max([t_hi] + extra)
         return np.unique(np.concatenate([np.linspace(0.0, t_hi, 1001), extra]))
 
-    # ---- what the scene calls for (design.md section 6) -------------------
+    # ---- what the scene calls for (docs/design.md, section 6) -------------------
     def has_sliding(self, t_end: float, n: int = 2001) -> bool:
         ts = np.linspace(0.0, t_end, n)
         return any(self.motion.V(t) != 0.0 for t in ts)

@@ -1,4 +1,4 @@
-"""Bad input never escapes as anything but femehl's documented errors (issue 7, item 4).
+"""Bad input never escapes as anything but femehl's documented errors.
 
 Property-based (hypothesis): random and malformed scene values, run parameters, scene
 files (structured TOML, random text, random bytes) and mesh files (random bytes,

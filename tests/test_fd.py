@@ -22,7 +22,7 @@ from femehl.scene import (
     Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Table, Winkler,
 )
 
-F_HERTZ = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (design.md s. 2)
+F_HERTZ = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (docs/design.md, section 2)
 P0_HERTZ = 2.0 / math.pi ** 2         # normalized Hertz central pressure
 
 
@@ -68,7 +68,7 @@ def rigid_scene(L=2.0):
 
 def test_rigid_scene_is_valid_and_sparse():
     """Scene validation allows hc > 0 throughout (no contact, no domain check), and a rigid
-    substrate builds no dense operator (design.md section 6)."""
+    substrate builds no dense operator (docs/design.md, section 6)."""
     sc = rigid_scene()
     eff = sc.effects(1.0)
     assert eff["squeeze"] and not eff["sliding"] and eff["elasticity"] == "rigid"
@@ -383,7 +383,7 @@ def paper_t2():
 def test_paper_exit_constriction(paper_t2):
     """Paper case at t = 2 (V = tanh 1 = 0.76), dr = 0.025, dtheta = pi/36 (~3 min).
 
-    The substrate moves toward -x, so the exit is at x < 0 (design.md s. 1).
+    The substrate moves toward -x, so the exit is at x < 0 (docs/design.md, section 1).
     Checked: the global film minimum is on the exit side (observed
     (-0.34, 0.94), a side lobe of the horseshoe); on the centreline the film
     minimum (the constriction) lies at -1.15 < x < -0.85 (observed -1.075);
@@ -394,7 +394,7 @@ def test_paper_exit_constriction(paper_t2):
     exceeds the inlet-side value (0.093 vs 0.069), the asymmetry that builds
     the spike.  At beta = 200 and this resolution the exit "spike" is a shoulder
     above the Hertz pressure, not a local maximum: the FE solver on finer meshes
-    gives the same monotone fall (see the closing note of issue 3).
+    gives the same monotone fall.
     """
     res = paper_t2
     s = res.state_at(2.0)

@@ -71,7 +71,7 @@ def test_step_reproduces_a_p1_pressure(linear_solver):
 
 
 def test_rigid_and_winkler_build_no_dense_matrix():
-    """A rigid or Winkler scene must never build a dense operator (design.md s. 6)."""
+    """A rigid or Winkler scene must never build a dense operator (docs/design.md, section 6)."""
     for sub in (Rigid(), Winkler(2.0)):
         sc = Scene(substrate=sub, motion=Motion(gap=RampHold(0.5, 0.1, 1.0)))
         st = FEStepper(sc, mesh="medium")
@@ -128,7 +128,7 @@ def test_fe_converges_under_mesh_refinement():
     """Load and central film at t = 1 (end of indentation) converge along the ladder.
 
     Differences between successive rungs (each ~2x the elements, h / 1.45) shrink;
-    measured here: see the closing note of issue 4 (observed order ~2 in h for the load).
+    measured in benchmarks/accuracy_results.md (observed order ~2 in h for the load).
     """
     sc = femehl.presets.paper_sphere()
     vals = []

@@ -84,7 +84,7 @@ def test_poisson_ratio_out_of_range(nu):
 
 @pytest.mark.parametrize("nu", [0.5, 0.3, 0.0, -0.99])
 def test_poisson_ratio_in_range(nu):
-    """compliance 2(1 - nu): the factor 1/G -> 2(1 - nu)/G of design.md section 1."""
+    """compliance 2(1 - nu): the factor 1/G -> 2(1 - nu)/G of docs/design.md, section 1."""
     assert HalfSpace(nu).compliance == pytest.approx(2 * (1 - nu))
 
 
@@ -206,7 +206,7 @@ def test_dimensional_beta_by_hand():
 
 
 def test_dimensional_hertz_consistency():
-    """design.md section 7: F = (16/3) G sqrt(R) delta^(3/2) at delta = h_inf must be the
+    """docs/design.md, section 7: F = (16/3) G sqrt(R) delta^(3/2) at delta = h_inf must be the
     normalized Hertz load 4/(3 pi) times the force scale, and p0 = (8 G/pi) sqrt(delta/R)
     must be 2/pi^2 times the pressure scale.  Checks the scales against an independent law."""
     dim = Dimensional(**SI)

@@ -1,4 +1,4 @@
-"""Scenes beyond the paper (issue 5): indenter shapes, substrates, imposed load, SI, files.
+"""Scenes beyond the paper: indenter shapes, substrates, imposed load, SI, files.
 
 Physics checks here:
 
@@ -33,7 +33,7 @@ from femehl.scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motio
 from femehl.scenefile import SUBSTRATES, load_scene_file
 from femehl.stepping import march
 
-HERTZ_LOAD = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (design.md s. 2)
+HERTZ_LOAD = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (docs/design.md, section 2)
 
 
 def ripple(x, y):

@@ -1,4 +1,4 @@
-"""Stress corners, the relaxation baseline, failure handling and resume (issue 7).
+"""Stress corners, the relaxation baseline, failure handling and resume.
 
 The full stress matrix is ``femehl bench stress`` (benchmarks/stress.py, results in
 benchmarks/stress_results.md); here a reduced form runs its corners on the coarse mesh.

@@ -70,8 +70,9 @@ def check_paper_figures(mod, tmp_path):
     """Figs. 5-7 with both solvers, shortened to the indentation (t <= 1, coarse grids, same
     dt): FE and FD loads agree within 2 % at t = 0.5 and 1 (the FD at dr = 0.05 is first
     order; its load changes by 0.15 % from dr = 0.05 to 0.025), and the three figures exist."""
-    summary = mod.main(out=tmp_path, t_end=1.0, dt=0.05, mesh="coarse", fd_dr=0.05,
-                       fd_divisions=12, log=lambda *a: None)
+    summary = mod.main(
+        out=tmp_path, t_end=1.0, dt=0.05, mesh="coarse", fd_dr=0.05, fd_divisions=12, log=lambda *a: None
+    )
     for t in (0.5, 1.0):
         fe, fd = summary[t]["load"]
         assert abs(fe - fd) < 0.02 * fd, (t, fe, fd)
@@ -104,8 +105,19 @@ def test_toml_twin_is_the_same_scene(name, tmp_path):
     assert sc == load_example(name).scene()
     assert run["method"] == "fe" and run["mesh"] == "coarse"
     # (dt = 0.05 is too coarse for the first step of a suddenly applied Hertz load: rupture)
-    rc = cli_main(["run", str(EXAMPLES / f"{name}.toml"), "--t-end", "0.1", "--dt", "0.02",
-                   "--out", str(tmp_path), "--quiet"])
+    rc = cli_main(
+        [
+            "run",
+            str(EXAMPLES / f"{name}.toml"),
+            "--t-end",
+            "0.1",
+            "--dt",
+            "0.02",
+            "--out",
+            str(tmp_path),
+            "--quiet",
+        ]
+    )
     assert rc == 0 and (tmp_path / "summary.csv").exists()
 
 

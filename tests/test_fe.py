@@ -5,21 +5,23 @@ The FE-vs-FD cross-validation lives in tests/test_crossval.py.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import femehl
-from femehl.api import make_stepper
 from femehl.fe.solver import FEStepper
-from femehl.scene import Constant, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
+from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
 
 
 def rigid_scene(beta=1.0, V=0.0):
-    return Scene(indenter=Sphere(), substrate=Rigid(), fluid=Fluid(beta),
-                 motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=V), domain=Domain(2.0))
+    return Scene(
+        indenter=Sphere(),
+        substrate=Rigid(),
+        fluid=Fluid(beta),
+        motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=V),
+        domain=Domain(2.0),
+    )
 
 
 def test_patch_linear_pressure_has_zero_residual():
@@ -33,7 +35,7 @@ def test_patch_linear_pressure_has_zero_residual():
     nodes = st.disc.nodes
     d = np.full(st.disc.nelements, 0.37)
     n = st.disc.nnodes
-    data = (st._k_data * (d ** 3)[None, :]).ravel()
+    data = (st._k_data * (d**3)[None, :]).ravel()
     K = sp.csr_matrix((data, (st._k_rows, st._k_cols)), shape=(n, n))
     for a, b, c in [(1.0, 0.0, 0.0), (0.3, -2.0, 0.0), (0.0, 0.7, 1.3)]:
         p = a + b * nodes[:, 0] + c * nodes[:, 1]
@@ -155,7 +157,7 @@ def test_linear_solver_paths_agree(opts):
     kw = dict(mesh="coarse", t_end=1.6, dt=0.02, store_every=20, rtol=1e-10)
     ref = femehl.solve(sc, "fe", **kw)
     other = femehl.solve(sc, "fe", **kw, **opts)
-    for a, b in zip(ref.states, other.states):
+    for a, b in zip(ref.states, other.states, strict=True):
         assert np.allclose(a.d, b.d, rtol=1e-7, atol=0)
         assert np.allclose(a.p, b.p, rtol=0, atol=1e-7 * np.abs(b.p).max() + 1e-300)
 
@@ -168,5 +170,5 @@ def test_default_tolerance_is_far_below_discretization_error():
     kw = dict(mesh="coarse", t_end=2.0, dt=0.02, store_every=25)
     ref = femehl.solve(sc, "fe", linear_solver="lu", **kw)
     res = femehl.solve(sc, "fe", **kw)
-    for a, b in zip(ref.states, res.states):
+    for a, b in zip(ref.states, res.states, strict=True):
         assert np.allclose(a.d, b.d, rtol=1e-5, atol=0)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import pathlib
 import re
 
@@ -24,7 +23,7 @@ def test_readme_block_runs(index, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     import femehl
 
-    namespace = {"femehl": femehl}                   # blocks after the first omit the import
+    namespace = {"femehl": femehl}  # blocks after the first omit the import
     exec(compile(python_blocks()[index], f"README block {index}", "exec"), namespace)
     if index == 0:
         assert (tmp_path / "femehl-out" / "readme" / "fields.pvd").exists()

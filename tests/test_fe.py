@@ -126,24 +126,27 @@ def test_half_and_full_disk_agree():
             assert abs(a - b) < 0.02 * abs(b), (name, t, a, b)
 
 
-def test_fe_converges_under_mesh_refinement():
+def test_fe_converges_under_mesh_refinement(paper_scene, paper_reference):
     """Load and central film at t = 1 (end of indentation) converge along the ladder.
 
     Differences between successive rungs (each ~2x the elements, h / 1.45) shrink;
     measured in benchmarks/accuracy_results.md (observed order ~2 in h for the load).
     """
-    sc = femehl.presets.paper_sphere()
     vals = []
     for mesh in ("coarse", "medium", "fine"):
-        r = femehl.solve(sc, "fe", mesh=mesh, t_end=1.0, dt=0.02, store_every=0)
+        r = femehl.solve(paper_scene, "fe", mesh=mesh, t_end=1.0, dt=0.02, store_every=0)
         vals.append((r.value_at("load", 1.0), r.value_at("film_center", 1.0)))
     vals = np.array(vals)
     diffs = np.abs(np.diff(vals, axis=0))
     assert np.all(diffs[1] < diffs[0])
     order = np.log(diffs[0] / diffs[1]) / np.log(1.45)
     assert np.all(order > 0.8), order
-    # Hertz-like load at the end of indentation, 4/(3 pi) = 0.424, plus the viscous excess
-    assert 0.42 < vals[-1, 0] < 0.52
+    # the fine rung against the reference: Euler at dt = 0.02 is first order in time and its
+    # time error dominates (load -0.62 %, central film -2.79 % measured here; "FE euler medium
+    # dt=0.02" in benchmarks/accuracy_results.md: 0.63 % / 2.8 %); tolerances about 2x those
+    ref = paper_reference[1.0]
+    assert vals[-1, 0] == pytest.approx(ref["load"], rel=0.013)
+    assert vals[-1, 1] == pytest.approx(ref["film_center"], rel=0.055)
 
 
 @pytest.mark.parametrize("opts", [dict(linear_solver="lu"), dict(recycle=0), dict(refactor_after=4)])

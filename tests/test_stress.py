@@ -7,11 +7,13 @@ Corners (coarse mesh, T = 0.1, dt = 0.05, t_end = 3):
 
 * beta = 2 (viscous / fast: thick films, large squeeze term) with h0 = 0.01 and 1: stable.
 * beta = 20000 (inviscid / slow: films of order 1e-3 at the contact edge) with h0 = 0.01
-  and 1: the coarse mesh and this dt cannot follow the film, which goes negative at one
-  element; the run stops with the documented FilmRuptureError naming time and place.
-  This is resolution, not physics: lubrication films do not reach zero in finite time,
-  and the benchmark shows beta = 20000 at dt = 0.01 surviving on finer meshes (see
-  benchmarks/stress_results.md).  The test pins the documented failure mode.
+  and 1: today the coarse mesh and this dt cannot follow the film, which goes negative at
+  one element (at t = 0.05 and 0.55), and the run stops with the documented
+  FilmRuptureError naming time and place.  This is resolution, not physics: lubrication
+  films do not reach zero in finite time, and the benchmark shows beta = 20000 at
+  dt = 0.01 surviving on finer meshes (see benchmarks/stress_results.md).  The test
+  accepts either outcome a correct solver may give -- completion with positive, finite
+  films, or the documented failure mode -- and not a particular rupture time.
 """
 
 from __future__ import annotations
@@ -69,27 +71,32 @@ def test_soft_viscous_corner_is_stable(h0):
     assert row["stable"]
     assert 0.0 < row["film_min"] <= h0 + 0.01  # h0 + s at the nearest centroid
     # each step solves its weak form: the solver stops at ||b - A p|| <= 1e-8 ||b|| (default
-    # rtol); this residual is scaled by the squeeze/Couette terms instead (measured <= ~10 rtol)
-    assert row["mass_residual_max"] < 100 * 1e-8
+    # rtol); this residual is scaled by the squeeze/Couette terms instead: measured 7.2 rtol
+    # (h0 = 0.01) and 8.4 rtol (h0 = 1); bound about 2x
+    assert row["mass_residual_max"] < 17 * 1e-8
 
 
-@pytest.mark.parametrize("h0, t_stop", [(0.01, 0.05), (1.0, 0.55)])
-def test_thin_film_corner_stops_with_documented_rupture(h0, t_stop):
+@pytest.mark.parametrize("h0", [0.01, 1.0])
+def test_thin_film_corner_completes_or_stops_with_documented_rupture(h0):
     stepper = femehl.make_stepper(stress.paper_scene(20000.0, h0, 0.1), "fe", mesh="coarse")
     reached = []
-    with pytest.raises(FilmRuptureError) as info:
+    try:
         for s in march(stepper, 3.0, 0.05):
             reached.append(s)
-    exc = info.value
-    assert exc.t == pytest.approx(t_stop, abs=0.051)
-    assert exc.d_min <= 0.0
-    x, y = exc.where
-    assert math.hypot(x, y) < 2.0
-    msg = str(exc)
-    for part in (f"t = {exc.t:.6g}", "(x, y)", "ruptured", "solid contact", "smaller dt", "finer mesh"):
-        assert part in msg
+    except FilmRuptureError as exc:
+        # the documented failure mode: when, where, how thin, and what to try
+        assert 0.0 < exc.t <= 3.0 + 1e-9
+        assert exc.d_min <= 0.0
+        x, y = exc.where
+        assert math.hypot(x, y) < 2.0
+        msg = str(exc)
+        for part in (f"t = {exc.t:.6g}", "(x, y)", "ruptured", "solid contact", "smaller dt", "finer mesh"):
+            assert part in msg
+        assert not reached or reached[-1].t < exc.t
+    else:
+        assert reached[-1].t == pytest.approx(3.0)
+    # every state handed out before a stop (or all of them) is physical
     assert all(s.film_min > 0 and np.all(np.isfinite(s.p)) for s in reached)
-    assert reached[-1].t < exc.t
 
 
 def test_oscillation_measures():
@@ -156,8 +163,8 @@ def test_femehl_step_solves_its_weak_form():
     for s in march(st, 1.3, 0.1):
         if prev is not None:
             # the solver stops at ||b - A p|| <= rtol ||b||; this residual is scaled by the
-            # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound 100 rtol)
-            assert mass_balance_residual(st, prev, s) < 100 * st.rtol
+            # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound about 2x)
+            assert mass_balance_residual(st, prev, s) < 16 * st.rtol
         prev = s
 
 
@@ -198,6 +205,8 @@ def test_rupture_leaves_readable_output(tmp_path):
     with pytest.raises(FilmRuptureError) as info:
         run_to_folder(rupturing_scene(), out, mesh="coarse", t_end=1.0, dt=0.05, store_every=2, log=quiet)
     exc = info.value
+    # not a solver-dependent time: on a rigid substrate d = h exactly, so the tip film is
+    # hc(t) and must vanish in the step that crosses hc = 0, whatever the solver
     hc_zero = 0.2 / 0.7  # hc(t) = 0 here
     assert hc_zero - 1e-9 < exc.t <= hc_zero + 0.05 + 1e-9
     assert math.hypot(*exc.where) < 0.5  # at the tip

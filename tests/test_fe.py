@@ -126,7 +126,7 @@ def test_half_and_full_disk_agree():
             assert abs(a - b) < 0.02 * abs(b), (name, t, a, b)
 
 
-def test_fe_converges_under_mesh_refinement(paper_scene, paper_reference):
+def test_fe_converges_under_mesh_refinement(paper_scene, paper_reference, quick_fe):
     """Load and central film at t = 1 (end of indentation) converge along the ladder.
 
     Differences between successive rungs (each ~2x the elements, h / 1.45) shrink;
@@ -134,7 +134,7 @@ def test_fe_converges_under_mesh_refinement(paper_scene, paper_reference):
     """
     vals = []
     for mesh in ("coarse", "medium", "fine"):
-        r = femehl.solve(paper_scene, "fe", mesh=mesh, t_end=1.0, dt=0.02, store_every=0)
+        r = femehl.solve(paper_scene, "fe", **{**quick_fe, "mesh": mesh}, t_end=1.0)
         vals.append((r.value_at("load", 1.0), r.value_at("film_center", 1.0)))
     vals = np.array(vals)
     diffs = np.abs(np.diff(vals, axis=0))

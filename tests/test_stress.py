@@ -200,8 +200,8 @@ def _check_series(folder):
     return times
 
 
-def test_rupture_leaves_readable_output(tmp_path):
-    out = tmp_path / "run"
+def test_rupture_leaves_readable_output(out_dir):
+    out = out_dir
     with pytest.raises(FilmRuptureError) as info:
         run_to_folder(rupturing_scene(), out, mesh="coarse", t_end=1.0, dt=0.05, store_every=2, log=quiet)
     exc = info.value

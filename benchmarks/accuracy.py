@@ -1,4 +1,4 @@
-"""What accuracy costs: error against wall time for the FE and FD solvers (issue 6).
+"""What accuracy costs: error against wall time for the FE and FD solvers.
 
     femehl bench accuracy [--quick] [--out DIR] [--resume] [--analyze-only]
                           [--part study|timestep|all] [--fd-extra]
@@ -46,10 +46,18 @@ import time
 HERE = pathlib.Path(__file__).resolve().parent
 T_END = 5.0
 MESHES = ("coarse", "medium", "fine", "xfine")
-RATIO = 1.45            # femehl.fe.mesh.LADDER_RATIO (checked in the worker)
+RATIO = 1.45  # femehl.fe.mesh.LADDER_RATIO (checked in the worker)
 XPROF = (-1.5, 1.5, 301)
-QUANTS = ("load@1", "film_center@1", "film_min@1", "load@5", "film_center@5", "film_min@5",
-          "profile@1", "profile@5")
+QUANTS = (
+    "load@1",
+    "film_center@1",
+    "film_min@1",
+    "load@5",
+    "film_center@5",
+    "film_min@5",
+    "profile@1",
+    "profile@5",
+)
 SCALARS = QUANTS[:6]
 
 
@@ -67,16 +75,22 @@ def fd_case(dr_div, th_div, dt, **kw):
 
 def fe_cases(quick):
     if quick:
-        return [fe_case(m, dt, s) for m in ("coarse", "medium") for dt in (0.02, 0.01)
-                for s in ("euler", "bdf2")]
+        return [
+            fe_case(m, dt, s) for m in ("coarse", "medium") for dt in (0.02, 0.01) for s in ("euler", "bdf2")
+        ]
     cases = []
-    for m in ("coarse", "medium"):                       # cheap: the full grid
-        cases += [fe_case(m, dt, s, **({"series": True} if m == "medium" else {}))
-                  for dt in (0.02, 0.01, 0.005) for s in ("euler", "bdf2")]
+    for m in ("coarse", "medium"):  # cheap: the full grid
+        cases += [
+            fe_case(m, dt, s, **({"series": True} if m == "medium" else {}))
+            for dt in (0.02, 0.01, 0.005)
+            for s in ("euler", "bdf2")
+        ]
     # fine: euler at dt = 0.02 is dominated (its ~6 % time error exceeds every spatial error
     # at a cost above the medium runs); the rest is kept.
-    cases += [fe_case("fine", dt, s) for dt, s in ((0.01, "euler"), (0.005, "euler"),
-                                                   (0.02, "bdf2"), (0.01, "bdf2"), (0.005, "bdf2"))]
+    cases += [
+        fe_case("fine", dt, s)
+        for dt, s in ((0.01, "euler"), (0.005, "euler"), (0.02, "bdf2"), (0.01, "bdf2"), (0.005, "bdf2"))
+    ]
     # xfine: only the two bdf2 runs the reference needs (euler there is dominated: same
     # cost per step as bdf2, first-order time error of ~1-3 %).
     cases += [fe_case("xfine", dt, "bdf2") for dt in (0.01, 0.005)]
@@ -91,28 +105,34 @@ def fe_cases(quick):
 def fd_cases(quick, extra):
     if quick:
         return [fd_case(40, 24, 0.02)]
-    cases = [fd_case(40, 24, 0.01),          # dr = 0.05,  pi/24: ruptures at t ~ 1.6
-             fd_case(80, 24, 0.01),          # dr = 0.025, pi/24: ruptures at t ~ 2.6
-             fd_case(60, 36, 0.01),          # dr = 0.0333, pi/36
-             fd_case(80, 36, 0.02),
-             fd_case(80, 36, 0.01)]          # dr = 0.025, pi/36 (2765 unknowns)
+    cases = [
+        fd_case(40, 24, 0.01),  # dr = 0.05,  pi/24: ruptures at t ~ 1.6
+        fd_case(80, 24, 0.01),  # dr = 0.025, pi/24: ruptures at t ~ 2.6
+        fd_case(60, 36, 0.01),  # dr = 0.0333, pi/36
+        fd_case(80, 36, 0.02),
+        fd_case(80, 36, 0.01),
+    ]  # dr = 0.025, pi/36 (2765 unknowns)
     if extra:
-        cases += [fd_case(80, 48, 0.01)]     # dr = 0.025, pi/48 (3713 unknowns)
+        cases += [fd_case(80, 48, 0.01)]  # dr = 0.025, pi/48 (3713 unknowns)
     return cases
 
 
 def ts_cases():
     """Time-step study on the medium mesh (plus the runs shared with the main study)."""
-    cases = [fe_case("medium", dt, s, series=True) for dt in (0.04, 0.02, 0.01, 0.005, 0.0025)
-             for s in ("euler", "bdf2")]
+    cases = [
+        fe_case("medium", dt, s, series=True)
+        for dt in (0.04, 0.02, 0.01, 0.005, 0.0025)
+        for s in ("euler", "bdf2")
+    ]
     for beta in (200.0, 2000.0):
         for s in ("euler", "bdf2"):
             for dt in (0.05, 0.1, 0.2):
                 cases.append(fe_case("medium", dt, s, beta=beta, series=True, stability=True))
         # beta = 2000 needs its own small-dt reference trajectory
         if beta != 200.0:
-            cases += [fe_case("medium", dt, "bdf2", beta=beta, series=True, stability=True)
-                      for dt in (0.01, 0.02)]
+            cases += [
+                fe_case("medium", dt, "bdf2", beta=beta, series=True, stability=True) for dt in (0.01, 0.02)
+            ]
             cases += [fe_case("medium", 0.02, "euler", beta=beta, series=True, stability=True)]
     return cases
 
@@ -154,6 +174,7 @@ def worker(spec):
     scene = femehl.presets.paper_sphere(beta=spec.get("beta", 200.0))
     if spec["solver"] == "fe":
         from femehl.fe.mesh import LADDER_RATIO
+
         assert abs(LADDER_RATIO - RATIO) < 1e-12
         opts = dict(mesh=spec["mesh"], scheme=spec["scheme"])
         if spec.get("linear_solver"):
@@ -200,15 +221,29 @@ def worker(spec):
     if mv:
         out["matvec_s"] = float(np.median(mv))
         out["matvec_samples"] = len(mv)
-    out.update(status=status, t_fail=t_fail, setup_s=setup, stepping_s=stepping, nsteps=nsteps,
-               wall_s=setup + stepping, step_s=stepping / max(nsteps, 1),
-               peak_rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-               loadavg=[load0, os.getloadavg()[0]])
+    out.update(
+        status=status,
+        t_fail=t_fail,
+        setup_s=setup,
+        stepping_s=stepping,
+        nsteps=nsteps,
+        wall_s=setup + stepping,
+        step_s=stepping / max(nsteps, 1),
+        peak_rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        loadavg=[load0, os.getloadavg()[0]],
+    )
     if "matvec_s" in out:
         out["step_over_matvec"] = out["step_s"] / out["matvec_s"]
     info = getattr(st, "info", {})
-    for k in ("elements", "unknowns", "operator_bytes", "factorizations", "krylov_iterations",
-              "factor_s", "krylov_s"):
+    for k in (
+        "elements",
+        "unknowns",
+        "operator_bytes",
+        "factorizations",
+        "krylov_iterations",
+        "factor_s",
+        "krylov_s",
+    ):
         if k in info:
             out[k] = info[k]
     xs = np.linspace(*XPROF)
@@ -241,8 +276,9 @@ def run_in_subprocess(spec, log):
     p = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if p.returncode != 0:
         log.write(p.stderr)
-        return dict(spec, status="crashed", error=p.stderr.strip().splitlines()[-1:],
-                    wall_s=time.perf_counter() - t)
+        return dict(
+            spec, status="crashed", error=p.stderr.strip().splitlines()[-1:], wall_s=time.perf_counter() - t
+        )
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
@@ -251,12 +287,14 @@ def run_in_subprocess(spec, log):
 # ---------------------------------------------------------------------------
 def _val(r, q):
     import numpy as np
+
     v = r.get(q)
     return None if v is None else np.asarray(v, dtype=float)
 
 
 def _norm(v):
     import numpy as np
+
     xs = np.linspace(*XPROF)
     return float(np.sqrt(np.trapezoid(np.asarray(v) ** 2, xs))) if np.ndim(v) else abs(float(v))
 
@@ -271,13 +309,19 @@ def reference(runs, meshes, dts, p_t=2.0):
 
     def get(mesh, dt):
         for r in runs:
-            if (r["solver"], r["scheme"], r.get("mesh"), r["dt"], r.get("beta", 200.0),
-                    r.get("linear_solver"), r.get("threads", 1)) == \
-                    ("fe", "bdf2", mesh, dt, 200.0, None, 1) and r["status"] == "ok":
+            if (
+                r["solver"],
+                r["scheme"],
+                r.get("mesh"),
+                r["dt"],
+                r.get("beta", 200.0),
+                r.get("linear_solver"),
+                r.get("threads", 1),
+            ) == ("fe", "bdf2", mesh, dt, 200.0, None, 1) and r["status"] == "ok":
                 return r
         raise KeyError(f"missing FE bdf2 run {mesh} dt={dt}")
 
-    f_t = 1.0 / (2.0 ** p_t - 1.0) if dts[0] / dts[1] == 2 else None
+    f_t = 1.0 / (2.0**p_t - 1.0) if dts[0] / dts[1] == 2 else None
     ref = {}
     for q in QUANTS:
         # time-extrapolated value on each of the three meshes
@@ -292,20 +336,27 @@ def reference(runs, meshes, dts, p_t=2.0):
         flag = ""
         usable = signs_ok and 0.5 <= order <= 4.0
         if not usable:
-            flag = (f"observed order {order:.2f} not usable (non-monotone or out of [0.5, 4]): "
-                    "used 2; uncertainty includes the order-1 extrapolation")
+            flag = (
+                f"observed order {order:.2f} not usable (non-monotone or out of [0.5, 4]): "
+                "used 2; uncertainty includes the order-1 extrapolation"
+            )
             order = 2.0
-        fh = 1.0 / (RATIO ** order - 1.0)
-        best = vt[2] + d2 * fh                     # (fine, xfine) pair
-        other = vt[1] + d1 * fh                    # (medium, fine) pair, same order
+        fh = 1.0 / (RATIO**order - 1.0)
+        best = vt[2] + d2 * fh  # (fine, xfine) pair
+        other = vt[1] + d1 * fh  # (medium, fine) pair, same order
         t_corr = vt[2] - _val(get(meshes[2], dts[1]), q)
         scale = _norm(best)
-        unc = _norm(best - other) / scale          # different rung pairs
-        if not usable:                             # not in the asymptotic range: order 1 too
+        unc = _norm(best - other) / scale  # different rung pairs
+        if not usable:  # not in the asymptotic range: order 1 too
             unc = max(unc, _norm(d2 * (1.0 / (RATIO - 1.0) - fh)) / scale)
-        ref[q] = dict(value=best, order_h=order, flag=flag, unc_pairs=unc,
-                      unc_time=_norm(t_corr) / scale,             # size of the dt correction
-                      h_corr=_norm(d2 * fh) / scale)
+        ref[q] = dict(
+            value=best,
+            order_h=order,
+            flag=flag,
+            unc_pairs=unc,
+            unc_time=_norm(t_corr) / scale,  # size of the dt correction
+            h_corr=_norm(d2 * fh) / scale,
+        )
     return ref
 
 
@@ -326,14 +377,20 @@ def machine():
     import numpy as np
     import scipy
 
-    info = dict(python=platform.python_version(), numpy=np.__version__, scipy=scipy.__version__,
-                platform=platform.platform())
+    info = dict(
+        python=platform.python_version(),
+        numpy=np.__version__,
+        scipy=scipy.__version__,
+        platform=platform.platform(),
+    )
     try:
         cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        info["cpu"] = next((ln.split(":", 1)[1].strip() for ln in cpu.splitlines()
-                            if ln.startswith("Model name")), "?")
-        info["cpus"] = next((ln.split(":", 1)[1].strip() for ln in cpu.splitlines()
-                             if ln.startswith("CPU(s)")), "?")
+        info["cpu"] = next(
+            (ln.split(":", 1)[1].strip() for ln in cpu.splitlines() if ln.startswith("Model name")), "?"
+        )
+        info["cpus"] = next(
+            (ln.split(":", 1)[1].strip() for ln in cpu.splitlines() if ln.startswith("CPU(s)")), "?"
+        )
     except OSError:
         pass
     try:
@@ -343,6 +400,7 @@ def machine():
         pass
     try:
         from threadpoolctl import threadpool_info
+
         info["blas"] = ", ".join(f"{d.get('internal_api')} {d.get('version')}" for d in threadpool_info())
     except ImportError:
         try:
@@ -364,31 +422,67 @@ def machine():
     return info
 
 
-CSV_COLS = ["solver", "scheme", "resolution", "dt", "threads", "linear_solver", "status", "t_fail",
-            "elements", "unknowns", "nsteps", "setup_s", "stepping_s", "wall_s", "step_ms",
-            "matvec_ms", "step_over_matvec", "factorizations", "krylov_its_per_step",
-            "peak_rss_mb", "operator_bytes", "bytes_per_element"] + [f"err_{q}" for q in QUANTS] \
+CSV_COLS = (
+    [
+        "solver",
+        "scheme",
+        "resolution",
+        "dt",
+        "threads",
+        "linear_solver",
+        "status",
+        "t_fail",
+        "elements",
+        "unknowns",
+        "nsteps",
+        "setup_s",
+        "stepping_s",
+        "wall_s",
+        "step_ms",
+        "matvec_ms",
+        "step_over_matvec",
+        "factorizations",
+        "krylov_its_per_step",
+        "peak_rss_mb",
+        "operator_bytes",
+        "bytes_per_element",
+    ]
+    + [f"err_{q}" for q in QUANTS]
     + list(SCALARS)
+)
 
 
 def row(r, err):
     res = r["mesh"] if r["solver"] == "fe" else f"dr=2/{r['dr_div']} dth=pi/{r['th_div']}"
     ne = r.get("elements")
     return dict(
-        solver=r["solver"], scheme=r["scheme"], resolution=res, dt=r["dt"],
-        threads=r.get("threads", 1), linear_solver=r.get("linear_solver") or
-        ("krylov" if r["solver"] == "fe" else "lu"), status=r["status"], t_fail=r.get("t_fail"),
-        elements=ne, unknowns=r.get("unknowns"), nsteps=r.get("nsteps"),
-        setup_s=r.get("setup_s"), stepping_s=r.get("stepping_s"), wall_s=r.get("wall_s"),
+        solver=r["solver"],
+        scheme=r["scheme"],
+        resolution=res,
+        dt=r["dt"],
+        threads=r.get("threads", 1),
+        linear_solver=r.get("linear_solver") or ("krylov" if r["solver"] == "fe" else "lu"),
+        status=r["status"],
+        t_fail=r.get("t_fail"),
+        elements=ne,
+        unknowns=r.get("unknowns"),
+        nsteps=r.get("nsteps"),
+        setup_s=r.get("setup_s"),
+        stepping_s=r.get("stepping_s"),
+        wall_s=r.get("wall_s"),
         step_ms=1e3 * r["step_s"] if r.get("step_s") else None,
         matvec_ms=1e3 * r["matvec_s"] if r.get("matvec_s") else None,
-        step_over_matvec=r.get("step_over_matvec"), factorizations=r.get("factorizations"),
-        krylov_its_per_step=(r["krylov_iterations"] / r["nsteps"]) if r.get("krylov_iterations")
-        is not None and r.get("nsteps") else None,
-        peak_rss_mb=r.get("peak_rss_mb"), operator_bytes=r.get("operator_bytes"),
+        step_over_matvec=r.get("step_over_matvec"),
+        factorizations=r.get("factorizations"),
+        krylov_its_per_step=(r["krylov_iterations"] / r["nsteps"])
+        if r.get("krylov_iterations") is not None and r.get("nsteps")
+        else None,
+        peak_rss_mb=r.get("peak_rss_mb"),
+        operator_bytes=r.get("operator_bytes"),
         bytes_per_element=(r["operator_bytes"] / ne) if ne and r.get("operator_bytes") else None,
         **{f"err_{q}": err.get(q) for q in QUANTS},
-        **{q: r.get(q) for q in SCALARS})
+        **{q: r.get(q) for q in SCALARS},
+    )
 
 
 def _fmt(v, nd=3):
@@ -405,6 +499,7 @@ def _fmt(v, nd=3):
 
 def write_csv(path, rows):
     import csv
+
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=CSV_COLS)
         w.writeheader()
@@ -413,45 +508,68 @@ def write_csv(path, rows):
 
 
 def is_study(r):
-    return (r.get("beta", 200.0) == 200.0 and r.get("t_end", T_END) == T_END
-            and not r.get("stability") and r.get("threads", 1) == 1 and not r.get("linear_solver"))
+    return (
+        r.get("beta", 200.0) == 200.0
+        and r.get("t_end", T_END) == T_END
+        and not r.get("stability")
+        and r.get("threads", 1) == 1
+        and not r.get("linear_solver")
+    )
 
 
 def pareto_plot(path, runs, errs, ref):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
 
     fig, axes = plt.subplots(2, 4, figsize=(17, 8), sharex=True)
-    styles = {("fe", "euler"): ("C0", "o", "FE euler (paper scheme)"),
-              ("fe", "bdf2"): ("C1", "s", "FE bdf2"),
-              ("fd", "euler"): ("C3", "^", "FD euler (paper)")}
-    for ax, q in zip(axes.ravel(), QUANTS):
+    styles = {
+        ("fe", "euler"): ("C0", "o", "FE euler (paper scheme)"),
+        ("fe", "bdf2"): ("C1", "s", "FE bdf2"),
+        ("fd", "euler"): ("C3", "^", "FD euler (paper)"),
+    }
+    for ax, q in zip(axes.ravel(), QUANTS, strict=True):
         for (solver, scheme), (col, mk, lab) in styles.items():
-            pts = sorted((r["wall_s"], errs[i][q]) for i, r in enumerate(runs)
-                         if r["solver"] == solver and r["scheme"] == scheme and q in errs[i]
-                         and is_study(r) and r["status"] == "ok")
+            pts = sorted(
+                (r["wall_s"], errs[i][q])
+                for i, r in enumerate(runs)
+                if r["solver"] == solver
+                and r["scheme"] == scheme
+                and q in errs[i]
+                and is_study(r)
+                and r["status"] == "ok"
+            )
             if not pts:
                 continue
             x, y = np.array(pts).T
             y = np.maximum(y, 1e-7)
             ax.loglog(x, y, mk, color=col, alpha=0.45, ms=5)
-            fx, fy, best = [], [], np.inf          # Pareto front: cheapest first, error falling
-            for xi, yi in zip(x, y):
+            fx, fy, best = [], [], np.inf  # Pareto front: cheapest first, error falling
+            for xi, yi in zip(x, y, strict=True):
                 if yi < best:
                     best = yi
                     fx.append(xi)
                     fy.append(yi)
             ax.loglog(fx, fy, "-" + mk, color=col, label=lab, ms=6)
-        if q.endswith("@1"):      # FD ruptures during sliding: its cost to t = 1
-            pts = [(r["setup_s"] + r["step_s"] * round(1.0 / r["dt"]), errs[i][q])
-                   for i, r in enumerate(runs) if r["solver"] == "fd" and q in errs[i]
-                   and r.get("step_s")]
+        if q.endswith("@1"):  # FD ruptures during sliding: its cost to t = 1
+            pts = [
+                (r["setup_s"] + r["step_s"] * round(1.0 / r["dt"]), errs[i][q])
+                for i, r in enumerate(runs)
+                if r["solver"] == "fd" and q in errs[i] and r.get("step_s")
+            ]
             if pts:
                 x, y = np.array(sorted(pts)).T
-                ax.loglog(x, np.maximum(y, 1e-7), "^", color="C3", mfc="none", ms=7,
-                          label="FD (paper), cost to t = 1; ruptures at t = 1.6-2.6")
+                ax.loglog(
+                    x,
+                    np.maximum(y, 1e-7),
+                    "^",
+                    color="C3",
+                    mfc="none",
+                    ms=7,
+                    label="FD (paper), cost to t = 1; ruptures at t = 1.6-2.6",
+                )
         unc = max(ref[q]["unc_pairs"], ref[q]["unc_time"])
         lo = ax.get_ylim()[0]
         ax.axhspan(lo, max(unc, lo), color="0.85", zorder=0, label="reference uncertainty")
@@ -479,50 +597,84 @@ def analyze(out, runs, quick):
         ref = reference(runs, ("coarse", "medium", "medium"), (0.02, 0.01))
     else:
         ref = reference(runs, ("medium", "fine", "xfine"), (0.01, 0.005))
-    errs = [errors(r, ref) if r["status"] == "ok" or r.get("load@1") is not None else {}
-            for r in runs]
-    rows = [row(r, e) for r, e in zip(runs, errs)]
+    errs = [errors(r, ref) if r["status"] == "ok" or r.get("load@1") is not None else {} for r in runs]
+    rows = [row(r, e) for r, e in zip(runs, errs, strict=True)]
     write_csv(out / "accuracy_results.csv", rows)
     pareto_plot(out / "accuracy_pareto.png", runs, errs, ref)
 
     lines = []
     mi = machine()
     lines.append("# femehl accuracy vs cost (paper case, beta = 200, h0 = 0.1, t in [0, 5])\n")
-    lines.append("Generated by `femehl bench accuracy" + (" --quick" if quick else "") + "`. Machine: "
-                 + ", ".join(f"{k} {v}" for k, v in mi.items()) + ".\n")
+    lines.append(
+        "Generated by `femehl bench accuracy"
+        + (" --quick" if quick else "")
+        + "`. Machine: "
+        + ", ".join(f"{k} {v}" for k, v in mi.items())
+        + ".\n"
+    )
     lines.append("## Reference\n")
     if quick:
-        lines.append("QUICK MODE: the reference is extrapolated from coarse/medium only; "
-                     "errors below are indicative.\n")
+        lines.append(
+            "QUICK MODE: the reference is extrapolated from coarse/medium only; "
+            "errors below are indicative.\n"
+        )
     else:
-        lines.append("Richardson extrapolation of FE bdf2: in dt (order 2, dt = 0.01 and 0.005) on "
-                     "each of medium, fine, xfine, then in h (ratio 1.45, observed order from the "
-                     "three time-extrapolated rungs) from the (fine, xfine) pair. Uncertainty: "
-                     "difference to the (medium, fine) extrapolation (same order), and the size "
-                     "of the dt correction on xfine.\n")
-    lines.append("| quantity | reference | observed order in h | uncertainty (rung pairs; order 1 too if flagged) | "
-                 "dt correction | h correction | note |")
+        lines.append(
+            "Richardson extrapolation of FE bdf2: in dt (order 2, dt = 0.01 and 0.005) on "
+            "each of medium, fine, xfine, then in h (ratio 1.45, observed order from the "
+            "three time-extrapolated rungs) from the (fine, xfine) pair. Uncertainty: "
+            "difference to the (medium, fine) extrapolation (same order), and the size "
+            "of the dt correction on xfine.\n"
+        )
+    lines.append(
+        "| quantity | reference | observed order in h | uncertainty (rung pairs; order 1 too if flagged) | "
+        "dt correction | h correction | note |"
+    )
     lines.append("|---|---|---|---|---|---|---|")
     for q in QUANTS:
         v = ref[q]["value"]
         sv = _fmt(float(v), 6) if np.ndim(v) == 0 else f"L2 norm {_norm(v):.5g}"
-        lines.append(f"| {q} | {sv} | {ref[q]['order_h']:.2f} | {100 * ref[q]['unc_pairs']:.3f} % | "
-                     f"{100 * ref[q]['unc_time']:.3f} % | {100 * ref[q]['h_corr']:.3f} % | "
-                     f"{ref[q]['flag']} |")
+        lines.append(
+            f"| {q} | {sv} | {ref[q]['order_h']:.2f} | {100 * ref[q]['unc_pairs']:.3f} % | "
+            f"{100 * ref[q]['unc_time']:.3f} % | {100 * ref[q]['h_corr']:.3f} % | "
+            f"{ref[q]['flag']} |"
+        )
     lines.append("\n## Runs (errors in %; wall = set-up + stepping, 1 BLAS thread unless noted)\n")
-    head = ["run", "status", "el./unknowns", "set-up s", "stepping s", "wall s", "ms/step",
-            "step/matvec", "LU", "its/step", "peak MB", "op. B/el."] + [q for q in QUANTS]
+    head = [
+        "run",
+        "status",
+        "el./unknowns",
+        "set-up s",
+        "stepping s",
+        "wall s",
+        "ms/step",
+        "step/matvec",
+        "LU",
+        "its/step",
+        "peak MB",
+        "op. B/el.",
+    ] + [q for q in QUANTS]
     lines.append("| " + " | ".join(head) + " |")
     lines.append("|" + "---|" * len(head))
-    for r, w, e in zip(runs, rows, errs):
+    for r, w, e in zip(runs, rows, errs, strict=True):
         if r.get("stability") or (r.get("series") and not is_study(r)):
             continue
         size = f"{w['elements']}/{w['unknowns']}" if w["elements"] else f"-/{w['unknowns']}"
         st = w["status"] if w["status"] == "ok" else f"{w['status']} at t={_fmt(w['t_fail'])}"
-        cells = [label(r), st, size, _fmt(w["setup_s"]), _fmt(w["stepping_s"]), _fmt(w["wall_s"]),
-                 _fmt(w["step_ms"]), _fmt(w["step_over_matvec"]), _fmt(w["factorizations"]),
-                 _fmt(w["krylov_its_per_step"]), _fmt(w["peak_rss_mb"], 4),
-                 _fmt(w["bytes_per_element"], 4)]
+        cells = [
+            label(r),
+            st,
+            size,
+            _fmt(w["setup_s"]),
+            _fmt(w["stepping_s"]),
+            _fmt(w["wall_s"]),
+            _fmt(w["step_ms"]),
+            _fmt(w["step_over_matvec"]),
+            _fmt(w["factorizations"]),
+            _fmt(w["krylov_its_per_step"]),
+            _fmt(w["peak_rss_mb"], 4),
+            _fmt(w["bytes_per_element"], 4),
+        ]
         cells += [_fmt(100 * e[q]) if q in e else "" for q in QUANTS]
         lines.append("| " + " | ".join(cells) + " |")
 
@@ -535,8 +687,11 @@ def analyze(out, runs, quick):
         for solver in ("fe", "fd"):
             cells = []
             for lvl in (1e-2, 1e-3):
-                ok = [(r["wall_s"], label(r), e[q]) for r, e in zip(study, [errs[runs.index(s)] for s in study])
-                      if r["solver"] == solver and r["status"] == "ok" and q in e and e[q] <= lvl]
+                ok = [
+                    (r["wall_s"], label(r), e[q])
+                    for r, e in zip(study, [errs[runs.index(s)] for s in study], strict=True)
+                    if r["solver"] == solver and r["status"] == "ok" and q in e and e[q] <= lvl
+                ]
                 if not ok:
                     c = "none"
                 else:
@@ -553,9 +708,13 @@ def analyze(out, runs, quick):
     lines.append("| error level | run | wall s | worst quantity |")
     lines.append("|---|---|---|---|")
     for lvl in (1e-2, 3e-3, 1e-3):
-        ok = [(r["wall_s"], label(r), max(errs[runs.index(r)].items(), key=lambda kv: kv[1]))
-              for r in study if r["status"] == "ok" and len(errs[runs.index(r)]) == len(QUANTS)
-              and max(errs[runs.index(r)].values()) <= lvl]
+        ok = [
+            (r["wall_s"], label(r), max(errs[runs.index(r)].items(), key=lambda kv: kv[1]))
+            for r in study
+            if r["status"] == "ok"
+            and len(errs[runs.index(r)]) == len(QUANTS)
+            and max(errs[runs.index(r)].values()) <= lvl
+        ]
         if ok:
             w_, lab, (wq, wv) = min(ok)
             lines.append(f"| {100 * lvl:g} % | {lab} | {w_:.1f} | {wq} ({100 * wv:.3g} %) |")
@@ -568,12 +727,17 @@ def analyze(out, runs, quick):
     # set-up + steps to t = 1 at its mean step time.
     q1 = [q for q in QUANTS if q.endswith("@1")]
     lines.append("\n## FE vs FD at equal error, at t = 1 (the FD runs rupture during sliding)\n")
-    lines.append("FD cost: set-up + steps to t = 1. FE: the cheapest run whose errors in ALL of "
-                 + ", ".join(q1) + " are at most the FD run's worst; its cost is its whole run to "
-                 "t = 5 (conservative) and, in brackets, its cost to t = 1 (set-up + steps at the "
-                 "mean step time).\n")
-    lines.append("| FD run | ruptured at t | FD cost to t = 1 (s) | FD worst error at t = 1 | "
-                 "cheapest FE run as accurate | FE whole run s (to t = 1) | speed-up (to t = 1) |")
+    lines.append(
+        "FD cost: set-up + steps to t = 1. FE: the cheapest run whose errors in ALL of "
+        + ", ".join(q1)
+        + " are at most the FD run's worst; its cost is its whole run to "
+        "t = 5 (conservative) and, in brackets, its cost to t = 1 (set-up + steps at the "
+        "mean step time).\n"
+    )
+    lines.append(
+        "| FD run | ruptured at t | FD cost to t = 1 (s) | FD worst error at t = 1 | "
+        "cheapest FE run as accurate | FE whole run s (to t = 1) | speed-up (to t = 1) |"
+    )
     lines.append("|---|---|---|---|---|---|---|")
     for r in runs:
         if r["solver"] != "fd" or not r.get("step_s") or r.get("load@1") is None:
@@ -581,13 +745,17 @@ def analyze(out, runs, quick):
         e = errs[runs.index(r)]
         emax = max(e[q] for q in q1)
         fd_cost = r["setup_s"] + r["step_s"] * round(1.0 / r["dt"])
-        cands = [(f["wall_s"], f["setup_s"] + f["step_s"] * round(1.0 / f["dt"]), label(f))
-                 for f in study if f["solver"] == "fe" and f["status"] == "ok"
-                 and all(errs[runs.index(f)][q] <= emax for q in q1)]
+        cands = [
+            (f["wall_s"], f["setup_s"] + f["step_s"] * round(1.0 / f["dt"]), label(f))
+            for f in study
+            if f["solver"] == "fe" and f["status"] == "ok" and all(errs[runs.index(f)][q] <= emax for q in q1)
+        ]
         if cands:
             w_, w1, lab = min(cands)
-            lines.append(f"| {label(r)} | {_fmt(r.get('t_fail'))} | {fd_cost:.1f} | {100 * emax:.3g} % | "
-                         f"{lab} | {w_:.1f} ({w1:.1f}) | {fd_cost / w_:.0f}x ({fd_cost / w1:.0f}x) |")
+            lines.append(
+                f"| {label(r)} | {_fmt(r.get('t_fail'))} | {fd_cost:.1f} | {100 * emax:.3g} % | "
+                f"{lab} | {w_:.1f} ({w1:.1f}) | {fd_cost / w_:.0f}x ({fd_cost / w1:.0f}x) |"
+            )
     (out / "accuracy_results.md").write_text("\n".join(lines) + "\n")
     print("\n".join(summary))
     return ref, errs
@@ -601,9 +769,13 @@ def analyze_timestep(out, runs):
 
     def find(scheme, dt, beta=200.0):
         for r in runs:
-            if (r["solver"], r.get("mesh"), r["scheme"], r["dt"], r.get("beta", 200.0)) == \
-                    ("fe", "medium", scheme, dt, beta) and r.get("series") \
-                    and not r.get("linear_solver") and r.get("threads", 1) == 1:
+            if (
+                (r["solver"], r.get("mesh"), r["scheme"], r["dt"], r.get("beta", 200.0))
+                == ("fe", "medium", scheme, dt, beta)
+                and r.get("series")
+                and not r.get("linear_solver")
+                and r.get("threads", 1) == 1
+            ):
                 return r
         return None
 
@@ -613,13 +785,20 @@ def analyze_timestep(out, runs):
         print("timestep: reference runs missing")
         return
     ref = {q: b[q] + (b[q] - a[q]) / 3.0 for q in qs}
-    lines = ["# femehl time-step study (paper case, medium mesh)\n",
-             "Error of each quantity against the dt -> 0 limit ON THE SAME MESH (Richardson of "
-             "bdf2 at dt = 0.005 and 0.0025, order 2), so only the time error is measured. "
-             "Observed order between successive dt (ratio 2, except 0.04/0.02).\n"]
+    lines = [
+        "# femehl time-step study (paper case, medium mesh)\n",
+        "Error of each quantity against the dt -> 0 limit ON THE SAME MESH (Richardson of "
+        "bdf2 at dt = 0.005 and 0.0025, order 2), so only the time error is measured. "
+        "Observed order between successive dt (ratio 2, except 0.04/0.02).\n",
+    ]
     rows = []
-    lines.append("| scheme | dt | wall s | " + " | ".join(f"err {q} %" for q in qs) + " | "
-                 + " | ".join(f"order {q}" for q in qs) + " |")
+    lines.append(
+        "| scheme | dt | wall s | "
+        + " | ".join(f"err {q} %" for q in qs)
+        + " | "
+        + " | ".join(f"order {q}" for q in qs)
+        + " |"
+    )
     lines.append("|" + "---|" * (3 + 2 * len(qs)))
     for s in ("euler", "bdf2"):
         prev = None
@@ -631,22 +810,42 @@ def analyze_timestep(out, runs):
             o = {}
             if prev is not None:
                 for q in qs:
-                    o[q] = (math.log(prev[1][q] / e[q]) / math.log(prev[0] / dt)
-                            if e[q] > 0 and prev[1][q] > 0 else float("nan"))
+                    o[q] = (
+                        math.log(prev[1][q] / e[q]) / math.log(prev[0] / dt)
+                        if e[q] > 0 and prev[1][q] > 0
+                        else float("nan")
+                    )
             prev = (dt, e)
-            rows.append(dict(kind="error", scheme=s, dt=dt, beta=200.0, wall_s=r["wall_s"],
-                             **{f"err_{q}": e[q] for q in qs}, **{f"order_{q}": o.get(q) for q in qs}))
-            lines.append(f"| {s} | {dt:g} | {r['wall_s']:.1f} | "
-                         + " | ".join(_fmt(100 * e[q]) for q in qs) + " | "
-                         + " | ".join(_fmt(o.get(q)) for q in qs) + " |")
+            rows.append(
+                dict(
+                    kind="error",
+                    scheme=s,
+                    dt=dt,
+                    beta=200.0,
+                    wall_s=r["wall_s"],
+                    **{f"err_{q}": e[q] for q in qs},
+                    **{f"order_{q}": o.get(q) for q in qs},
+                )
+            )
+            lines.append(
+                f"| {s} | {dt:g} | {r['wall_s']:.1f} | "
+                + " | ".join(_fmt(100 * e[q]) for q in qs)
+                + " | "
+                + " | ".join(_fmt(o.get(q)) for q in qs)
+                + " |"
+            )
 
     lines.append("\n## Stability: largest dt that completes to t = 5 without spurious oscillation\n")
-    lines.append("Oscillation test: count the direction reversals of film_min(t_k) step to step and "
-                 "compare with the same count of a small-dt reference (bdf2) sampled at the same "
-                 "times; more than 2 extra reversals, or an error in film_min at t = 5 above 20 %, "
-                 "is called spurious.\n")
-    lines.append("| beta | scheme | dt | status | reversals (run / reference) | film_min at t=5 | "
-                 "error film_min@5 % (max over the run) | verdict |")
+    lines.append(
+        "Oscillation test: count the direction reversals of film_min(t_k) step to step and "
+        "compare with the same count of a small-dt reference (bdf2) sampled at the same "
+        "times; more than 2 extra reversals, or an error in film_min at t = 5 above 20 %, "
+        "is called spurious.\n"
+    )
+    lines.append(
+        "| beta | scheme | dt | status | reversals (run / reference) | film_min at t=5 | "
+        "error film_min@5 % (max over the run) | verdict |"
+    )
     lines.append("|---|---|---|---|---|---|---|---|")
     for beta in (200.0, 2000.0):
         refr = find("bdf2", 0.005 if beta == 200.0 else 0.01, beta)
@@ -677,11 +876,21 @@ def analyze_timestep(out, runs):
                     fm, efm = _fmt(float(fm), 5), _fmt(100 * efm) + f" (max over t: {100 * dev:.3g})"
                 st = r["status"] if r["status"] == "ok" else f"{r['status']} at t={_fmt(r.get('t_fail'))}"
                 lines.append(f"| {beta:g} | {s} | {dt:g} | {st} | {rev} | {fm} | {efm} | {verdict} |")
-                rows.append(dict(kind="stability", scheme=s, dt=dt, beta=beta, wall_s=r.get("wall_s"),
-                                 status=r["status"], verdict=verdict))
+                rows.append(
+                    dict(
+                        kind="stability",
+                        scheme=s,
+                        dt=dt,
+                        beta=beta,
+                        wall_s=r.get("wall_s"),
+                        status=r["status"],
+                        verdict=verdict,
+                    )
+                )
             lines.append(f"| {beta:g} | {s} | **largest stable tried: {largest}** | | | | | |")
     (out / "timestep.md").write_text("\n".join(lines) + "\n")
     import csv
+
     cols = sorted({k for r in rows for k in r}, key=lambda k: (k not in ("kind", "scheme", "beta", "dt"), k))
     with open(out / "timestep.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=cols)
@@ -695,8 +904,9 @@ def analyze_timestep(out, runs):
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="femehl bench accuracy", description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smoke test: coarse/medium only (~2 min)")
-    ap.add_argument("--out", default=None, help="output folder (default: benchmarks/, quick: "
-                    "benchmarks/quick/)")
+    ap.add_argument(
+        "--out", default=None, help="output folder (default: benchmarks/, quick: benchmarks/quick/)"
+    )
     ap.add_argument("--part", choices=["study", "timestep", "all"], default="all")
     ap.add_argument("--resume", action="store_true", help="skip runs already in runs.jsonl")
     ap.add_argument("--analyze-only", action="store_true", help="only rewrite tables and plot")
@@ -733,10 +943,17 @@ def main(argv=None):
                 done[k] = r
                 with open(store, "a") as fh:
                     fh.write(json.dumps({"spec": spec, "result": r}) + "\n")
-                print(f"[{i + 1}/{len(cases)}] {label(spec)}: {r['status']}, wall {r.get('wall_s', 0):.1f} s"
-                      + (f", {1e3 * r['step_s']:.1f} ms/step, {r.get('step_over_matvec', float('nan')):.1f} matvecs/step"
-                         if r.get("step_s") else "")
-                      + f"  [total {time.perf_counter() - t_all:.0f} s]", flush=True)
+                print(
+                    f"[{i + 1}/{len(cases)}] {label(spec)}: {r['status']}, wall {r.get('wall_s', 0):.1f} s"
+                    + (
+                        f", {1e3 * r['step_s']:.1f} ms/step, "
+                        f"{r.get('step_over_matvec', float('nan')):.1f} matvecs/step"
+                        if r.get("step_s")
+                        else ""
+                    )
+                    + f"  [total {time.perf_counter() - t_all:.0f} s]",
+                    flush=True,
+                )
     runs = [done[key(c)] for c in cases if key(c) in done]
     if a.part in ("study", "all"):
         analyze(out, runs, a.quick)

@@ -82,18 +82,44 @@ OMEGAS = (0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
 SAWTOOTH_LIMIT = 3
 NOISE = 1e-6
 
-COLUMNS = ("solver", "mesh", "beta", "h0", "T", "dt", "t_end", "status", "error", "t_reached",
-           "where_x", "where_y", "steps", "film_min", "film_min_end", "nonfinite",
-           "mass_residual_max", "load_residual", "osc_min_per_t", "osc_elem_per_t", "sawtooth",
-           "iters_mean", "iters_max", "wall_s", "stable")
+COLUMNS = (
+    "solver",
+    "mesh",
+    "beta",
+    "h0",
+    "T",
+    "dt",
+    "t_end",
+    "status",
+    "error",
+    "t_reached",
+    "where_x",
+    "where_y",
+    "steps",
+    "film_min",
+    "film_min_end",
+    "nonfinite",
+    "mass_residual_max",
+    "load_residual",
+    "osc_min_per_t",
+    "osc_elem_per_t",
+    "sawtooth",
+    "iters_mean",
+    "iters_max",
+    "wall_s",
+    "stable",
+)
 
 
 def paper_scene(beta: float, h0: float, T: float) -> Scene:
     """The paper's sphere (Eq. 12) with sliding ramp time ``T``."""
-    return Scene(indenter=Sphere(1.0), substrate=HalfSpace(0.5), fluid=Fluid(beta),
-                 motion=Motion(gap=RampHold(h0=h0, h_end=-1.0, t1=1.0),
-                               velocity=TanhStart(t1=1.0, T=T)),
-                 domain=Domain(2.0))
+    return Scene(
+        indenter=Sphere(1.0),
+        substrate=HalfSpace(0.5),
+        fluid=Fluid(beta),
+        motion=Motion(gap=RampHold(h0=h0, h_end=-1.0, t1=1.0), velocity=TanhStart(t1=1.0, T=T)),
+        domain=Domain(2.0),
+    )
 
 
 def horizon(T: float) -> float:
@@ -133,7 +159,7 @@ class OscillationTracker:
         if self.t_first is None:
             self.t_first = t
         self.t_last = t
-        # film_min (the issue's measure)
+        # film_min (the oscillation measure)
         s = int(np.sign(dmin)) if abs(dmin) > NOISE * abs(film_min) else 0
         if s and self.prev_dmin_sign and s != self.prev_dmin_sign:
             self.min_changes += 1
@@ -163,24 +189,53 @@ def make_case_stepper(solver: str, scene: Scene, mesh: str | None, omega: float 
         return femehl.make_stepper(scene, "fd", **FD_OPTIONS)
     if solver == "relax":
         from femehl.baseline import RelaxationStepper
+
         return RelaxationStepper(scene, mesh=mesh, omega=omega)
     raise ValueError(solver)
 
 
-def run_case(solver: str, beta: float, h0: float, T: float, dt: float, mesh: str | None = "coarse",
-             t_end: float | None = None, omega: float | None = None,
-             max_seconds: float | None = None) -> dict:
+def run_case(
+    solver: str,
+    beta: float,
+    h0: float,
+    T: float,
+    dt: float,
+    mesh: str | None = "coarse",
+    t_end: float | None = None,
+    omega: float | None = None,
+    max_seconds: float | None = None,
+) -> dict:
     """Run one case and return its row (a dict with the keys of COLUMNS)."""
     from femehl.baseline import mass_balance_residual
 
     t_end = horizon(T) if t_end is None else t_end
-    row = dict(solver=solver if solver != "relax" else f"relax(omega={omega:g})",
-               mesh=mesh if solver != "fd" else "dr=0.025,dth=pi/36", beta=beta, h0=h0, T=T, dt=dt,
-               t_end=t_end, status="completed", error="", t_reached=0.0, where_x="", where_y="",
-               steps=0, film_min=math.inf, film_min_end=math.nan, nonfinite=False,
-               mass_residual_max=0.0, load_residual="n/a (imposed gap)", osc_min_per_t=math.nan,
-               osc_elem_per_t=math.nan, sawtooth=0, iters_mean="", iters_max="", wall_s=0.0,
-               stable=False)
+    row = dict(
+        solver=solver if solver != "relax" else f"relax(omega={omega:g})",
+        mesh=mesh if solver != "fd" else "dr=0.025,dth=pi/36",
+        beta=beta,
+        h0=h0,
+        T=T,
+        dt=dt,
+        t_end=t_end,
+        status="completed",
+        error="",
+        t_reached=0.0,
+        where_x="",
+        where_y="",
+        steps=0,
+        film_min=math.inf,
+        film_min_end=math.nan,
+        nonfinite=False,
+        mass_residual_max=0.0,
+        load_residual="n/a (imposed gap)",
+        osc_min_per_t=math.nan,
+        osc_elem_per_t=math.nan,
+        sawtooth=0,
+        iters_mean="",
+        iters_max="",
+        wall_s=0.0,
+        stable=False,
+    )
     t0 = time.perf_counter()
     osc = OscillationTracker(1.0 + 3.0 * T)
     iters = []
@@ -188,8 +243,9 @@ def run_case(solver: str, beta: float, h0: float, T: float, dt: float, mesh: str
     try:
         stepper = make_case_stepper(solver, paper_scene(beta, h0, T), mesh, omega)
         for state in march(stepper, t_end, dt):
-            finite = (np.all(np.isfinite(state.p)) and np.all(np.isfinite(state.d))
-                      and math.isfinite(state.load))
+            finite = (
+                np.all(np.isfinite(state.p)) and np.all(np.isfinite(state.d)) and math.isfinite(state.load)
+            )
             if not finite:
                 row["nonfinite"] = True
             row["film_min"] = min(row["film_min"], state.film_min)
@@ -227,16 +283,20 @@ def run_case(solver: str, beta: float, h0: float, T: float, dt: float, mesh: str
         row["iters_mean"] = round(float(np.mean(iters)), 1)
         row["iters_max"] = int(max(iters))
     row["wall_s"] = round(time.perf_counter() - t0, 2)
-    row["stable"] = bool(row["status"] == "completed" and not row["nonfinite"]
-                         and row["sawtooth"] < SAWTOOTH_LIMIT)
+    row["stable"] = bool(
+        row["status"] == "completed" and not row["nonfinite"] and row["sawtooth"] < SAWTOOTH_LIMIT
+    )
     return row
 
 
 # ---- the matrix ---------------------------------------------------------------------------
 def fe_cases(quick: bool, meshes=("coarse", "medium"), medium_dts=(0.01, 0.05)):
     if quick:
-        return [dict(solver="fe", beta=b, h0=h, T=0.1, dt=0.05, mesh="coarse")
-                for b in (2.0, 20000.0) for h in (0.01, 1.0)]
+        return [
+            dict(solver="fe", beta=b, h0=h, T=0.1, dt=0.05, mesh="coarse")
+            for b in (2.0, 20000.0)
+            for h in (0.01, 1.0)
+        ]
     out = []
     for mesh, dts in (("coarse", DTS), ("medium", medium_dts)):
         if mesh not in meshes:
@@ -252,18 +312,28 @@ def fe_cases(quick: bool, meshes=("coarse", "medium"), medium_dts=(0.01, 0.05)):
 def fd_cases(quick: bool):
     if quick:
         return [dict(solver="fd", beta=200.0, h0=0.1, T=0.1, dt=0.05, mesh=None, t_end=1.5)]
-    out = [dict(solver="fd", beta=b, h0=h, T=0.1, dt=0.05, mesh=None)
-           for b in (2.0, 20000.0) for h in (0.01, 1.0)]
+    out = [
+        dict(solver="fd", beta=b, h0=h, T=0.1, dt=0.05, mesh=None)
+        for b in (2.0, 20000.0)
+        for h in (0.01, 1.0)
+    ]
     out.append(dict(solver="fd", beta=200.0, h0=0.1, T=0.1, dt=0.05, mesh=None))
     return out
 
 
 def relax_cases(quick: bool, omega: float):
     if quick:
-        return [dict(solver="relax", beta=b, h0=1.0, T=0.1, dt=0.05, mesh="coarse", omega=omega)
-                for b in (2.0, 20000.0)]
-    return [dict(solver="relax", beta=b, h0=h, T=T, dt=dt, mesh="coarse", omega=omega)
-            for b in BETAS for h in H0S for T in TS for dt in (0.01, 0.05)]
+        return [
+            dict(solver="relax", beta=b, h0=1.0, T=0.1, dt=0.05, mesh="coarse", omega=omega)
+            for b in (2.0, 20000.0)
+        ]
+    return [
+        dict(solver="relax", beta=b, h0=h, T=T, dt=dt, mesh="coarse", omega=omega)
+        for b in BETAS
+        for h in H0S
+        for T in TS
+        for dt in (0.01, 0.05)
+    ]
 
 
 def omega_scan(quick: bool, log=print):
@@ -279,11 +349,17 @@ def omega_scan(quick: bool, log=print):
             if r["iters_mean"] != "":
                 its.append(r["iters_mean"])
             rows.append(r)
-            log(f"  omega scan: omega = {om:g}, dt = {dt:g}: {r['status']} at t = {r['t_reached']:.3g}, "
-                f"iterations/step {r['iters_mean']} (max {r['iters_max']})")
-    best = max(omegas, key=lambda om: (sum(r["t_reached"] for r in rows if r["solver"] == f"relax(omega={om:g})"),
-                                       -np.mean([r["iters_mean"] or 1e9 for r in rows
-                                                 if r["solver"] == f"relax(omega={om:g})"])))
+            log(
+                f"  omega scan: omega = {om:g}, dt = {dt:g}: {r['status']} at t = {r['t_reached']:.3g}, "
+                f"iterations/step {r['iters_mean']} (max {r['iters_max']})"
+            )
+    best = max(
+        omegas,
+        key=lambda om: (
+            sum(r["t_reached"] for r in rows if r["solver"] == f"relax(omega={om:g})"),
+            -np.mean([r["iters_mean"] or 1e9 for r in rows if r["solver"] == f"relax(omega={om:g})"]),
+        ),
+    )
     return best, rows
 
 
@@ -327,10 +403,14 @@ def read_csv(path):
 
 def summary_lines(rows, omega=None):
     out = []
-    for label, pred in (("femehl FE", lambda r: r["solver"] == "fe"),
-                        ("femehl FD (paper-faithful reference)", lambda r: r["solver"] == "fd"),
-                        (f"relaxation baseline (omega = {omega:g})" if omega else "relaxation baseline",
-                         lambda r: r["solver"].startswith("relax"))):
+    for label, pred in (
+        ("femehl FE", lambda r: r["solver"] == "fe"),
+        ("femehl FD (paper-faithful reference)", lambda r: r["solver"] == "fd"),
+        (
+            f"relaxation baseline (omega = {omega:g})" if omega else "relaxation baseline",
+            lambda r: r["solver"].startswith("relax"),
+        ),
+    ):
         sel = [r for r in rows if pred(r)]
         if sel:
             n = sum(1 for r in sel if r["stable"])
@@ -338,8 +418,24 @@ def summary_lines(rows, omega=None):
     return out
 
 
-MD_COLUMNS = ("mesh", "beta", "h0", "T", "dt", "status", "t_reached", "film_min", "mass_residual_max",
-              "osc_min_per_t", "osc_elem_per_t", "sawtooth", "iters_mean", "iters_max", "wall_s", "stable")
+MD_COLUMNS = (
+    "mesh",
+    "beta",
+    "h0",
+    "T",
+    "dt",
+    "status",
+    "t_reached",
+    "film_min",
+    "mass_residual_max",
+    "osc_min_per_t",
+    "osc_elem_per_t",
+    "sawtooth",
+    "iters_mean",
+    "iters_max",
+    "wall_s",
+    "stable",
+)
 
 
 def _md_table(rows, cols=MD_COLUMNS):
@@ -350,25 +446,41 @@ def _md_table(rows, cols=MD_COLUMNS):
 
 
 def write_md(rows, path, omega, scan_rows, wall, notes=""):
-    lines = ["# Stress matrix: femehl FE, FD reference and the relaxation baseline", "",
-             "Generated by `femehl bench stress` (benchmarks/stress.py); the method, matrix and",
-             "definitions are in that file's docstring.  Stable = completed, all values finite, and",
-             f"no element whose film change reverses sign at {SAWTOOTH_LIMIT} consecutive steps (sawtooth).",
-             "", "## Summary", ""]
+    lines = [
+        "# Stress matrix: femehl FE, FD reference and the relaxation baseline",
+        "",
+        "Generated by `femehl bench stress` (benchmarks/stress.py); the method, matrix and",
+        "definitions are in that file's docstring.  Stable = completed, all values finite, and",
+        f"no element whose film change reverses sign at {SAWTOOTH_LIMIT} consecutive steps (sawtooth).",
+        "",
+        "## Summary",
+        "",
+    ]
     lines += [f"- {s}" for s in summary_lines(rows, omega)]
-    lines += ["", f"Wall time: {wall / 60:.1f} min, the sum of the cases' wall times (OMP_NUM_THREADS=1, "
-              "on a shared 2-core machine under load).", ""]
+    lines += [
+        "",
+        f"Wall time: {wall / 60:.1f} min, the sum of the cases' wall times (OMP_NUM_THREADS=1, "
+        "on a shared 2-core machine under load).",
+        "",
+    ]
     if notes:
         lines += ["## What fails and why", "", notes.strip(), ""]
     if scan_rows:
-        lines += ["## Relaxation: omega scan on the paper case (beta 200, h0 0.1, T 1, coarse mesh)", "",
-                  f"Best fixed omega (furthest time reached, then fewest iterations): {omega:g}.", ""]
-        lines += _md_table(scan_rows, ("solver", "dt", "status", "t_reached", "iters_mean", "iters_max",
-                                       "wall_s"))
+        lines += [
+            "## Relaxation: omega scan on the paper case (beta 200, h0 0.1, T 1, coarse mesh)",
+            "",
+            f"Best fixed omega (furthest time reached, then fewest iterations): {omega:g}.",
+            "",
+        ]
+        lines += _md_table(
+            scan_rows, ("solver", "dt", "status", "t_reached", "iters_mean", "iters_max", "wall_s")
+        )
         lines.append("")
-    for label, pred in (("femehl FE", lambda r: r["solver"] == "fe"),
-                        ("FD reference", lambda r: r["solver"] == "fd"),
-                        ("Relaxation baseline", lambda r: r["solver"].startswith("relax"))):
+    for label, pred in (
+        ("femehl FE", lambda r: r["solver"] == "fe"),
+        ("FD reference", lambda r: r["solver"] == "fd"),
+        ("Relaxation baseline", lambda r: r["solver"].startswith("relax")),
+    ):
         sel = [r for r in rows if pred(r)]
         if not sel:
             continue
@@ -377,8 +489,10 @@ def write_md(rows, path, omega, scan_rows, wall, notes=""):
         if stopped:
             lines += [f"### {label}: why the stopped cases stopped", ""]
             for r in stopped:
-                lines.append(f"- {r['mesh']}, beta {r['beta']:g}, h0 {r['h0']:g}, T {r['T']:g}, dt {r['dt']:g}: "
-                             f"{r['error'][:300]}")
+                lines.append(
+                    f"- {r['mesh']}, beta {r['beta']:g}, h0 {r['h0']:g}, T {r['T']:g}, dt {r['dt']:g}: "
+                    f"{r['error'][:300]}"
+                )
             lines.append("")
     path.write_text("\n".join(lines))
 
@@ -394,7 +508,8 @@ documented FilmRuptureError naming time and place; none crashed.  They fall in t
 1. beta = 20000, every h0, T, dt and both meshes (30 cases) -- numerics: resolution.
    The films are of order 1e-3 (beta = 2000 gives minimum films of 0.002-0.004;
    soft-EHL films fall roughly like beta^-0.65).  At dt = 0.05 the run stops during
-   the indentation ramp (t <= 0.55) at the tip: one step closes the rigid gap by (1 + h0) dt >= 0.05, more than the film,
+   the indentation ramp (t <= 0.55) at the tip: one step closes the rigid gap by
+   (1 + h0) dt >= 0.05, more than the film,
    while the film's mobility d^3 is lagged from the previous, thicker step -- the lag
    error is larger than the film.  At dt <= 0.01 the indentation survives and the run
    stops at t = 1.1-1.9 in the side lobes of the horseshoe constriction (r ~ 1,
@@ -413,7 +528,7 @@ documented FilmRuptureError naming time and place; none crashed.  They fall in t
    resolutions, stopped with the documented error rather than continued with a negative
    film.
 
-The issue's oscillation measure (sign changes of the change of the minimum film,
+The oscillation measure (sign changes of the change of the minimum film,
 osc_min_per_t) reaches 20-33 per unit time in the beta = 2-20, h0 = 0.01 cases: the
 minimum hops between neighbouring elements while the trapped pocket's rim travels
 through the exit (each element's film stays smooth: sawtooth <= 2), so it is reported
@@ -433,7 +548,8 @@ stops with RelaxationDivergedError, either because the iterate's film goes negat
 (divergence) or because 200 iterations do not bring the pressure change below 1e-6; in
 the 32 cases with at least one converged step the mean is 56-200 iterations per step
 (each iteration one sparse Reynolds solve and one dense elastic product, ~7 ms on the
-coarse mesh: 0.4-1.4 s per step against femehl's ~10 ms).  The fixed-point map's sensitivity (beta K)^-1 (M/dt) C has
+coarse mesh: 0.4-1.4 s per step against femehl's ~10 ms).  The fixed-point map's
+sensitivity (beta K)^-1 (M/dt) C has
 eigenvalues up to -9000 at beta = 2, dt = 0.002 already at t = 0 (film 0.1) and grows like
 1/(beta dt d^3) as the contact forms, so a fixed omega small enough to converge in the
 thin-film phase (< 2/(1 + |lambda|)) needs thousands of iterations per step everywhere.
@@ -449,10 +565,14 @@ def main(argv=None):
     ap.add_argument("--only", default="fe,fd,relax", help="comma list of solvers to run")
     ap.add_argument("--fe-meshes", default="coarse,medium", help="FE meshes of the matrix")
     ap.add_argument("--medium-dt", default="0.01,0.05", help="time steps run on the medium mesh")
-    ap.add_argument("--from-csv", action="store_true",
-                    help="only rewrite the Markdown from an existing stress_results.csv in --out")
-    ap.add_argument("--max-case-seconds", type=float, default=60.0,
-                    help="wall-time cap per relaxation case (default 60)")
+    ap.add_argument(
+        "--from-csv",
+        action="store_true",
+        help="only rewrite the Markdown from an existing stress_results.csv in --out",
+    )
+    ap.add_argument(
+        "--max-case-seconds", type=float, default=60.0, help="wall-time cap per relaxation case (default 60)"
+    )
     args = ap.parse_args(argv)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -464,10 +584,13 @@ def main(argv=None):
     def done(r):
         rows.append(r)
         write_csv(scan_rows + rows, csv_path)
-        print(f"{r['solver']:>18} {str(r['mesh']):>18} beta={r['beta']:<7g} h0={r['h0']:<5g} T={r['T']:<4g} "
-              f"dt={r['dt']:<6g} {r['status']:>9} t={r['t_reached']:.4g} dmin={r['film_min']:.3g} "
-              f"res={r['mass_residual_max']:.2g} saw={r['sawtooth']} osc={r['osc_min_per_t']:.3g} "
-              f"its={r['iters_mean']} {r['wall_s']:.1f}s stable={r['stable']}", flush=True)
+        print(
+            f"{r['solver']:>18} {str(r['mesh']):>18} beta={r['beta']:<7g} h0={r['h0']:<5g} T={r['T']:<4g} "
+            f"dt={r['dt']:<6g} {r['status']:>9} t={r['t_reached']:.4g} dmin={r['film_min']:.3g} "
+            f"res={r['mass_residual_max']:.2g} saw={r['sawtooth']} osc={r['osc_min_per_t']:.3g} "
+            f"its={r['iters_mean']} {r['wall_s']:.1f}s stable={r['stable']}",
+            flush=True,
+        )
 
     if args.from_csv:
         rows = read_csv(csv_path)
@@ -487,8 +610,9 @@ def main(argv=None):
         print(f"relaxation baseline: best omega = {omega:g}", flush=True)
     cases = []
     if "fe" in which:
-        cases += fe_cases(args.quick, args.fe_meshes.split(","),
-                          tuple(float(x) for x in args.medium_dt.split(",")))
+        cases += fe_cases(
+            args.quick, args.fe_meshes.split(","), tuple(float(x) for x in args.medium_dt.split(","))
+        )
     if "fd" in which:
         cases += fd_cases(args.quick)
     if "relax" in which:

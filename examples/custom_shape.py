@@ -25,9 +25,9 @@ from femehl.indenters import Shape
 from femehl.run import run_to_folder
 from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 
-AMPLITUDE = 0.05                 # ripple height, in units of h_inf
-WAVENUMBER = 6.0                 # 2 pi / wavelength, in units of 1/sqrt(R h_inf)
-ANGLE = math.radians(30.0)       # crest direction vs the sliding direction x
+AMPLITUDE = 0.05  # ripple height, in units of h_inf
+WAVENUMBER = 6.0  # 2 pi / wavelength, in units of 1/sqrt(R h_inf)
+ANGLE = math.radians(30.0)  # crest direction vs the sliding direction x
 
 
 def rippled_sphere(x, y):
@@ -37,14 +37,16 @@ def rippled_sphere(x, y):
 
 
 def scene(beta: float = 200.0) -> Scene:
-    return Scene(indenter=Shape(rippled_sphere, name="rippled sphere"), substrate=HalfSpace(0.5),
-                 fluid=Fluid(beta),
-                 motion=Motion(gap=RampHold(0.1, -1.0, 1.0), velocity=TanhStart(1.0, 1.0)),
-                 domain=Domain(2.0))
+    return Scene(
+        indenter=Shape(rippled_sphere, name="rippled sphere"),
+        substrate=HalfSpace(0.5),
+        fluid=Fluid(beta),
+        motion=Motion(gap=RampHold(0.1, -1.0, 1.0), velocity=TanhStart(1.0, 1.0)),
+        domain=Domain(2.0),
+    )
 
 
-def main(out="femehl-out/custom_shape", t_end: float = 5.0, mesh: str = "coarse",
-         dt: float = 0.01) -> dict:
+def main(out="femehl-out/custom_shape", t_end: float = 5.0, mesh: str = "coarse", dt: float = 0.01) -> dict:
     """Run the scene on the full disk; print and return the final load and films.
 
     Returns
@@ -55,12 +57,19 @@ def main(out="femehl-out/custom_shape", t_end: float = 5.0, mesh: str = "coarse"
     """
     t0 = time.perf_counter()
     res = run_to_folder(scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10)
-    o = {"load": float(res.load[-1]), "film_center": float(res.film_center[-1]),
-         "film_min": float(res.film_min[-1]), "half": bool(res.info["half"]),
-         "wall_s": time.perf_counter() - t0, "result": res}
-    print(f"t = {res.t[-1]:g}: load {o['load']:.5g}, central film {o['film_center']:.5g}, "
-          f"minimum film {o['film_min']:.5g}  ({'half' if o['half'] else 'full'} disk, "
-          f"{res.info['elements']} elements)  [{o['wall_s']:.1f} s]")
+    o = {
+        "load": float(res.load[-1]),
+        "film_center": float(res.film_center[-1]),
+        "film_min": float(res.film_min[-1]),
+        "half": bool(res.info["half"]),
+        "wall_s": time.perf_counter() - t0,
+        "result": res,
+    }
+    print(
+        f"t = {res.t[-1]:g}: load {o['load']:.5g}, central film {o['film_center']:.5g}, "
+        f"minimum film {o['film_min']:.5g}  ({'half' if o['half'] else 'full'} disk, "
+        f"{res.info['elements']} elements)  [{o['wall_s']:.1f} s]"
+    )
     return o
 
 

@@ -24,9 +24,17 @@ from femehl.line_steady import steady_line
 from femehl.scene import Motion, RampHold, TanhStart
 
 
-def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float = 1.0,
-         beta: float = 10.0, h_end: float = -0.5, L: float = 2.0,
-         outdir="femehl-out/cylinder", verbose: bool = True) -> dict:
+def main(
+    t_end: float = 15.0,
+    dt: float = 0.05,
+    n_elements: int = 400,
+    k: float = 1.0,
+    beta: float = 10.0,
+    h_end: float = -0.5,
+    L: float = 2.0,
+    outdir="femehl-out/cylinder",
+    verbose: bool = True,
+) -> dict:
     """Run the transient, compare its final state with the steady solution, plot.
 
     Returns
@@ -37,8 +45,9 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
         ``film_center_exact``, ``film_min``, ``film_min_exact``,
         ``film_min_x``, ``d_star``, ``run_s``, ``steady_s``, ``png``.
     """
-    scene = LineScene(k=k, beta=beta, L=L,
-                      motion=Motion(gap=RampHold(0.1, h_end, 1.0), velocity=TanhStart(1.0, 1.0)))
+    scene = LineScene(
+        k=k, beta=beta, L=L, motion=Motion(gap=RampHold(0.1, h_end, 1.0), velocity=TanhStart(1.0, 1.0))
+    )
     t0 = time.perf_counter()
     res = solve_line(scene, t_end, dt, n_elements=n_elements, store_every=max(1, int(round(0.5 / dt))))
     t1 = time.perf_counter()
@@ -51,16 +60,22 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
         "t_end": float(f.t),
         "film_error": float(np.abs(f.d - d_ex).max() / d_ex.min()),
         "load_error": float(abs(f.load - ex.load) / ex.load),
-        "load": f.load, "load_exact": ex.load,
-        "film_center": f.film_center, "film_center_exact": float(ex.film(0.0)),
-        "film_min": f.film_min, "film_min_exact": float(d_ex.min()),
-        "film_min_x": f.film_min_at[0], "d_star": ex.d_star,
-        "run_s": t1 - t0, "steady_s": t2 - t1,
+        "load": f.load,
+        "load_exact": ex.load,
+        "film_center": f.film_center,
+        "film_center_exact": float(ex.film(0.0)),
+        "film_min": f.film_min,
+        "film_min_exact": float(d_ex.min()),
+        "film_min_x": f.film_min_at[0],
+        "d_star": ex.d_star,
+        "run_s": t1 - t0,
+        "steady_s": t2 - t1,
     }
 
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -73,7 +88,7 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
     ax1.plot(xs, ex.pressure(xs), "k--", lw=1.2, label="exact steady")
     ax2.plot(res.disc.xc, f.d, "C0", lw=2)
     ax2.plot(xs, ex.film(xs), "k--", lw=1.2)
-    ax2.plot(xs, h_end + xs ** 2 / 2, ":", color="gray", lw=1, label="rigid gap h")
+    ax2.plot(xs, h_end + xs**2 / 2, ":", color="gray", lw=1, label="rigid gap h")
     ax1.set_ylabel("p")
     ax2.set_ylabel("d")
     ax2.set_xlabel("x  (cylinder slides toward +x)")
@@ -88,14 +103,19 @@ def main(t_end: float = 15.0, dt: float = 0.05, n_elements: int = 400, k: float 
     out["png"] = str(png)
 
     if verbose:
-        print(f"transient: {res.info['elements']} elements, {res.info['steps']} steps of dt = {dt:g} "
-              f"in {out['run_s']:.2f} s; steady solution in {out['steady_s']:.2f} s")
+        print(
+            f"transient: {res.info['elements']} elements, {res.info['steps']} steps of dt = {dt:g} "
+            f"in {out['run_s']:.2f} s; steady solution in {out['steady_s']:.2f} s"
+        )
         print(f"film  max|d - d_exact| / min d = {out['film_error']:.3e}")
-        print(f"load  FE {out['load']:.8f}  exact {out['load_exact']:.8f}  "
-              f"rel. error {out['load_error']:.3e}")
+        print(
+            f"load  FE {out['load']:.8f}  exact {out['load_exact']:.8f}  rel. error {out['load_error']:.3e}"
+        )
         print(f"film at x = 0: FE {out['film_center']:.6f}  exact {out['film_center_exact']:.6f}")
-        print(f"min film: FE {out['film_min']:.6f} at x = {out['film_min_x']:.3f}  "
-              f"exact {out['film_min_exact']:.6f};  d_* = {out['d_star']:.6f}")
+        print(
+            f"min film: FE {out['film_min']:.6f} at x = {out['film_min_x']:.3f}  "
+            f"exact {out['film_min_exact']:.6f};  d_* = {out['d_star']:.6f}"
+        )
         print(f"figure: {png}")
     return out
 
@@ -111,5 +131,4 @@ if __name__ == "__main__":
     ap.add_argument("--h-end", type=float, default=-0.5)
     ap.add_argument("--L", type=float, default=2.0)
     a = ap.parse_args()
-    main(t_end=a.t_end, dt=a.dt, n_elements=a.n, k=a.k, beta=a.beta, h_end=a.h_end, L=a.L,
-         outdir=a.outdir)
+    main(t_end=a.t_end, dt=a.dt, n_elements=a.n, k=a.k, beta=a.beta, h_end=a.h_end, L=a.L, outdir=a.outdir)

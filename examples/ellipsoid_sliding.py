@@ -24,13 +24,18 @@ from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Tanh
 
 def scene(Rx: float = 0.5, Ry: float = 2.0, h_end: float = -0.5, beta: float = 200.0) -> Scene:
     """Indent to ``h_end`` over t in [0, 1], then slide along +x with V = tanh(t - 1)."""
-    return Scene(indenter=Ellipsoid(Rx, Ry), substrate=HalfSpace(0.5), fluid=Fluid(beta),
-                 motion=Motion(gap=RampHold(0.1, h_end, 1.0), velocity=TanhStart(1.0, 1.0)),
-                 domain=Domain(2.0))
+    return Scene(
+        indenter=Ellipsoid(Rx, Ry),
+        substrate=HalfSpace(0.5),
+        fluid=Fluid(beta),
+        motion=Motion(gap=RampHold(0.1, h_end, 1.0), velocity=TanhStart(1.0, 1.0)),
+        domain=Domain(2.0),
+    )
 
 
-def main(out="femehl-out/ellipsoid_sliding", t_end: float = 5.0, mesh: str = "coarse",
-         dt: float = 0.01) -> dict:
+def main(
+    out="femehl-out/ellipsoid_sliding", t_end: float = 5.0, mesh: str = "coarse", dt: float = 0.01
+) -> dict:
     """Run the scene; print and return the final load and films.
 
     Returns
@@ -41,13 +46,19 @@ def main(out="femehl-out/ellipsoid_sliding", t_end: float = 5.0, mesh: str = "co
     t0 = time.perf_counter()
     res = run_to_folder(scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10)
     s = res.summary()
-    o = {"load": float(res.load[-1]), "film_center": float(res.film_center[-1]),
-         "film_min": float(res.film_min[-1]),
-         "film_min_at": (float(s["film_min_x"][-1]), float(s["film_min_y"][-1])),
-         "wall_s": time.perf_counter() - t0, "result": res}
+    o = {
+        "load": float(res.load[-1]),
+        "film_center": float(res.film_center[-1]),
+        "film_min": float(res.film_min[-1]),
+        "film_min_at": (float(s["film_min_x"][-1]), float(s["film_min_y"][-1])),
+        "wall_s": time.perf_counter() - t0,
+        "result": res,
+    }
     x, y = o["film_min_at"]
-    print(f"t = {res.t[-1]:g}: load {o['load']:.5g}, central film {o['film_center']:.5g}, "
-          f"minimum film {o['film_min']:.5g} at (x, y) = ({x:.3g}, {y:.3g})  [{o['wall_s']:.1f} s]")
+    print(
+        f"t = {res.t[-1]:g}: load {o['load']:.5g}, central film {o['film_center']:.5g}, "
+        f"minimum film {o['film_min']:.5g} at (x, y) = ({x:.3g}, {y:.3g})  [{o['wall_s']:.1f} s]"
+    )
     return o
 
 

@@ -5,7 +5,7 @@ h0 = 0.1):
 
 * Fig. 5, transient normal indentation: t = 0.5, 0.8, 1.0;
 * Fig. 6, transient sliding: t = 1.0, 1.5, 2.0 (exit constriction near x = -1);
-* Fig. 7, the long-time state at t = t_end (5 in the paper; design.md s. 7: at
+* Fig. 7, the long-time state at t = t_end (5 in the paper; docs/design.md, section 7: at
   t = 5 the films are still ~1 % from steady).
 
 FE: the default solver on the given ladder mesh.  FD: the paper's polar
@@ -23,22 +23,29 @@ import pathlib
 import sys
 import time
 
-import numpy as np
-
 import femehl
 from femehl.output import centreline_png
 
 
-def main(out="femehl-out/paper_figures", t_end=5.0, dt=0.02, mesh="medium", fd_dr=0.0125,
-         fd_divisions=36, log=print):
+def main(
+    out="femehl-out/paper_figures",
+    t_end=5.0,
+    dt=0.02,
+    mesh="medium",
+    fd_dr=0.0125,
+    fd_divisions=36,
+    log=print,
+):
     """Run both solvers and write fig5.png, fig6.png, fig7.png; return the compared figures."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     scene = femehl.presets.paper_sphere(beta=200.0, h0=0.1)
     store = max(1, int(round(0.1 / dt)))
     runs = {}
-    for label, kw in (("FE", dict(method="fe", mesh=mesh)),
-                      ("FD", dict(method="fd", dr=fd_dr, dtheta=math.pi / fd_divisions))):
+    for label, kw in (
+        ("FE", dict(method="fe", mesh=mesh)),
+        ("FD", dict(method="fd", dr=fd_dr, dtheta=math.pi / fd_divisions)),
+    ):
         t0 = time.perf_counter()
         runs[label] = femehl.solve(scene, t_end=t_end, dt=dt, store_every=store, **kw)
         log(f"{label}: {time.perf_counter() - t0:.1f} s")
@@ -55,8 +62,12 @@ def main(out="femehl-out/paper_figures", t_end=5.0, dt=0.02, mesh="medium", fd_d
             a, b = runs["FE"].value_at(q, t), runs["FD"].value_at(q, t)
             row[q] = (a, b)
         summary[t] = row
-        log(f"t = {t:4.2f}  " + "  ".join(f"{q}: FE {a:.4f} FD {b:.4f} ({100 * (a - b) / b:+.1f}%)"
-                                          for q, (a, b) in row.items()))
+        log(
+            f"t = {t:4.2f}  "
+            + "  ".join(
+                f"{q}: FE {a:.4f} FD {b:.4f} ({100 * (a - b) / b:+.1f}%)" for q, (a, b) in row.items()
+            )
+        )
     return summary
 
 

@@ -11,7 +11,7 @@ Every indenter is a frozen dataclass with
 
 All lengths are in the paper's normalized units (in-plane lengths in units of
 ``sqrt(R* h_inf)``, gaps in units of ``h_inf``, radii of curvature in units of
-the normalizing radius ``R*``; design.md section 2), so ``Sphere(1.0)`` is the
+the normalizing radius ``R*``; docs/design.md, section 2), so ``Sphere(1.0)`` is the
 paper's sphere.  :data:`INDENTERS` maps the scene-file names to the classes;
 :func:`si_indenter` builds an indenter from SI values for a
 :class:`~femehl.scene.Dimensional` experiment.

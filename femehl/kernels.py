@@ -1,7 +1,7 @@
 """Exact Boussinesq integrals of a uniform pressure over triangles and polar cells.
 
-Conventions (design.md section 4; paper Eq. 24-25)
--------------------------------------------------
+Conventions (docs/design.md, section 4; paper Eq. 24-25)
+--------------------------------------------------------
 The normalized deflection of an elastic half space under pressure p is
 ``w(x) = -c * int p(x') / |x - x'| dA'`` (Eq. 10b; c = 2(1 - nu), 1 for the
 incompressible case).  This module computes the *kernel* part

@@ -17,7 +17,7 @@ def paper_sphere(beta: float = 200.0, h0: float = 0.1, L: float = 2.0) -> Scene:
         The paper's beta (Eq. 10e): inverse sliding speed and loading rate.
     h0 : float, default: 0.1
         Initial tip clearance (> 0; the paper's printed -0.1 is a sign slip,
-        see design.md section 2).
+        see docs/design.md, section 2).
     L : float, default: 2.0
         Domain radius.
     """

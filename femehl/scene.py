@@ -1,7 +1,7 @@
 """Frozen descriptions of a soft-EHL problem: indenter, substrate, fluid, motion, domain.
 
-Conventions (design.md sections 1-2; Wu, Hui et al., JMPS 2022, Eqs. 8, 10, 12)
-------------------------------------------------------------------------------
+Conventions (docs/design.md, sections 1-2; Wu, Hui et al., JMPS 2022, Eqs. 8, 10, 12)
+-------------------------------------------------------------------------------------
 Everything in a :class:`Scene` is in the paper's normalized variables::
 
     r = r*/sqrt(R h_inf)     t = V_ss t*/(2 sqrt(R h_inf))

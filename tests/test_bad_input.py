@@ -1,4 +1,4 @@
-"""Bad input never escapes as anything but femehl's documented errors (issue 7, item 4).
+"""Bad input never escapes as anything but femehl's documented errors.
 
 Property-based (hypothesis): random and malformed scene values, run parameters, scene
 files (structured TOML, random text, random bytes) and mesh files (random bytes,
@@ -28,8 +28,19 @@ from hypothesis import strategies as st
 import femehl
 from femehl.errors import FemehlError, MeshError, SceneError, SceneFileError
 from femehl.fe.mesh import load_mesh
-from femehl.scene import (Constant, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere,
-                          Table, TanhStart, Winkler)
+from femehl.scene import (
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Sphere,
+    Table,
+    TanhStart,
+    Winkler,
+)
 from femehl.scenefile import load_scene_file, run_options
 from femehl.stepping import check_run
 
@@ -37,8 +48,12 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: Warnings (overflow in a user's extreme value, a singular-matrix warning before the solver
 #: raises) are not what this file checks: results must be finite or errors documented.
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning", "ignore::UserWarning")
-FAST = settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-SLOW = settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+FAST = settings(
+    max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
+SLOW = settings(
+    max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 
 
 def _numeric_string(s) -> bool:
@@ -55,7 +70,7 @@ junk = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.floats(min_value=-1e3, max_value=1e3),
     st.sampled_from([0.0, -0.0, -1.0, 1e-320, 5e-324, 1e308, -1e308, math.nan, math.inf]),
-    st.integers(-10**6, 10**6),
+    st.integers(-(10**6), 10**6),
     st.booleans(),
     st.none(),
     st.text(max_size=6),
@@ -89,7 +104,7 @@ def test_sphere_radius(R):
     if s is not None:
         assert isinstance(R, (int, float)) and R > 0 and math.isfinite(R)
         g = s.gap(0.3, 0.4)
-        assert math.isfinite(g) or R < 1e-300           # tiny R overflows: the stepper rejects it
+        assert math.isfinite(g) or R < 1e-300  # tiny R overflows: the stepper rejects it
 
 
 @FAST
@@ -106,7 +121,7 @@ def test_domain_radius(L):
     d = attempt(Domain, L)
     if d is not None:
         assert float(d.L) > 0 and math.isfinite(float(d.L))
-        attempt(Scene, domain=d)                         # too small for the indentation: SceneError
+        attempt(Scene, domain=d)  # too small for the indentation: SceneError
 
 
 @FAST
@@ -117,13 +132,15 @@ def test_ramp_hold(h0, h_end, t1, t):
         assert math.isfinite(r(t))
         sc = attempt(Scene, motion=Motion(gap=r))
         if sc is not None:
-            assert float(h0) > 0                         # h0 <= 0 is refused by the Scene
+            assert float(h0) > 0  # h0 <= 0 is refused by the Scene
 
 
 @FAST
-@given(times=st.one_of(junk, st.lists(junk, max_size=4), st.lists(st.floats(), max_size=5)),
-       values=st.one_of(junk, st.lists(junk, max_size=4), st.lists(st.floats(), max_size=5)),
-       t=st.floats(-5, 5))
+@given(
+    times=st.one_of(junk, st.lists(junk, max_size=4), st.lists(st.floats(), max_size=5)),
+    values=st.one_of(junk, st.lists(junk, max_size=4), st.lists(st.floats(), max_size=5)),
+    t=st.floats(-5, 5),
+)
 def test_table(times, values, t):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -132,7 +149,7 @@ def test_table(times, values, t):
         ts = np.asarray(tab.times)
         assert ts.size >= 1 and np.all(np.diff(ts) > 0) and np.all(np.isfinite(ts))
         v = tab(t)
-        if not math.isfinite(v):                        # finite values whose interpolation overflows
+        if not math.isfinite(v):  # finite values whose interpolation overflows
             with pytest.raises(SceneError):
                 Motion(gap=tab).hc(t)
 
@@ -177,24 +194,36 @@ def test_check_run(t_end, dt):
 
 
 @SLOW
-@given(beta=positive, h0=st.one_of(st.floats(1e-3, 2.0), junk), h_end=st.floats(-1.5, 1.0),
-       R=st.one_of(st.floats(0.2, 5.0), junk), L=st.one_of(st.just(2.0), st.floats(0.5, 4.0)),
-       substrate=st.sampled_from(["halfspace", "rigid", "winkler"]),
-       t_end=st.one_of(st.floats(0.01, 0.3), junk), steps=st.integers(1, 4),
-       store_every=st.one_of(st.integers(-1, 3), junk))
-def test_solve_gives_finite_results_or_a_documented_error(beta, h0, h_end, R, L, substrate, t_end,
-                                                          steps, store_every):
+@given(
+    beta=positive,
+    h0=st.one_of(st.floats(1e-3, 2.0), junk),
+    h_end=st.floats(-1.5, 1.0),
+    R=st.one_of(st.floats(0.2, 5.0), junk),
+    L=st.one_of(st.just(2.0), st.floats(0.5, 4.0)),
+    substrate=st.sampled_from(["halfspace", "rigid", "winkler"]),
+    t_end=st.one_of(st.floats(0.01, 0.3), junk),
+    steps=st.integers(1, 4),
+    store_every=st.one_of(st.integers(-1, 3), junk),
+)
+def test_solve_gives_finite_results_or_a_documented_error(
+    beta, h0, h_end, R, L, substrate, t_end, steps, store_every
+):
     """A short FD run (tiny grid) of a random scene: finite result or a femehl error."""
     try:
         sub = {"halfspace": HalfSpace(), "rigid": Rigid(), "winkler": Winkler(1.0)}[substrate]
-        scene = Scene(indenter=Sphere(R), substrate=sub, fluid=Fluid(beta),
-                      motion=Motion(gap=RampHold(h0, h_end, 1.0), velocity=TanhStart(0.05, 0.1)),
-                      domain=Domain(L))
+        scene = Scene(
+            indenter=Sphere(R),
+            substrate=sub,
+            fluid=Fluid(beta),
+            motion=Motion(gap=RampHold(h0, h_end, 1.0), velocity=TanhStart(0.05, 0.1)),
+            domain=Domain(L),
+        )
         dt = t_end / steps if isinstance(t_end, float) and math.isfinite(t_end) else t_end
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = femehl.solve(scene, "fd", t_end=t_end, dt=dt, store_every=store_every,
-                               dr=float(L) / 6, dtheta=math.pi / 6)
+            res = femehl.solve(
+                scene, "fd", t_end=t_end, dt=dt, store_every=store_every, dr=float(L) / 6, dtheta=math.pi / 6
+            )
     except FemehlError as exc:
         assert_documented(exc)
         return
@@ -209,8 +238,7 @@ hashable_junk = junk
 
 
 @settings(max_examples=15, deadline=None, derandomize=True)
-@given(option=st.sampled_from(["mesh", "scheme", "linear_solver", "rtol", "bogus"]),
-       value=hashable_junk)
+@given(option=st.sampled_from(["mesh", "scheme", "linear_solver", "rtol", "bogus"]), value=hashable_junk)
 def test_fe_options(option, value):
     """Malformed FE options are refused before any work (a valid value is not run)."""
     ok = {"mesh": ("coarse",), "scheme": ("euler", "bdf2"), "linear_solver": ("gmres", "lu", None)}
@@ -218,15 +246,19 @@ def test_fe_options(option, value):
     assume(not (option == "rtol" and isinstance(value, (int, float)) and 0 < value < 1e-2))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        st_ = attempt(femehl.make_stepper, femehl.presets.paper_sphere(), "fe",
-                      **{"mesh": "coarse", option: value})
+        st_ = attempt(
+            femehl.make_stepper, femehl.presets.paper_sphere(), "fe", **{"mesh": "coarse", option: value}
+        )
     assert st_ is None
 
 
 # ---- scene files ---------------------------------------------------------------------------
 KNOWN = {
-    "indenter": ["kind", "R"], "substrate": ["kind", "nu", "k"], "fluid": ["beta"],
-    "domain": ["L"], "run": ["method", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions"],
+    "indenter": ["kind", "R"],
+    "substrate": ["kind", "nu", "k"],
+    "fluid": ["beta"],
+    "domain": ["L"],
+    "run": ["method", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions"],
     "si": ["R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L"],
     "motion.gap": ["kind", "h0", "h_end", "t1", "value", "times", "values"],
     "motion.velocity": ["kind", "t1", "T", "V_ss", "value", "times", "values"],
@@ -253,9 +285,15 @@ def toml_value(v):
 
 
 toml_scalar = st.one_of(
-    st.floats(), st.floats(-5, 5), st.integers(-3, 10**4), st.booleans(),
-    st.sampled_from(KINDS), st.text(max_size=8).filter(lambda s: not _numeric_string(s)),
-    st.lists(st.floats(-2, 5), max_size=4), st.lists(st.sampled_from(KINDS), max_size=2))
+    st.floats(),
+    st.floats(-5, 5),
+    st.integers(-3, 10**4),
+    st.booleans(),
+    st.sampled_from(KINDS),
+    st.text(max_size=8).filter(lambda s: not _numeric_string(s)),
+    st.lists(st.floats(-2, 5), max_size=4),
+    st.lists(st.sampled_from(KINDS), max_size=2),
+)
 
 
 @st.composite
@@ -267,7 +305,7 @@ def toml_documents(draw):
         keys = draw(st.lists(st.sampled_from(KNOWN.get(t, ["x"]) + ["extra"]), max_size=5, unique=True))
         for k in keys:
             lines.append(f"{k} = {toml_value(draw(toml_scalar))}")
-    if draw(st.booleans()) and lines:                      # sometimes break the syntax
+    if draw(st.booleans()) and lines:  # sometimes break the syntax
         i = draw(st.integers(0, len(lines) - 1))
         lines[i] = lines[i][: draw(st.integers(0, len(lines[i])))]
     return "\n".join(lines) + "\n"
@@ -288,8 +326,7 @@ def _load_and_use(path):
             assert math.isfinite(scene.motion.hc(t)) and math.isfinite(scene.motion.V(t))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = femehl.solve(scene, "fd", t_end=0.1, dt=0.05, dr=scene.domain.L / 5,
-                               dtheta=math.pi / 5)
+            res = femehl.solve(scene, "fd", t_end=0.1, dt=0.05, dr=scene.domain.L / 5, dtheta=math.pi / 5)
         assert np.all(np.isfinite(res.load)) and np.all(np.isfinite(res.film_min))
     except FemehlError as exc:
         assert_documented(exc)
@@ -348,15 +385,20 @@ def test_truncated_ladder_mesh(cut):
     path = _scene_file(LADDER_MSH[:cut], ".msh")
     try:
         dm = attempt(load_mesh, path, L=2.0)
-        if dm is not None:                  # only the closing "$EndElements" was cut: all there
+        if dm is not None:  # only the closing "$EndElements" was cut: all there
             assert dm.mesh.t.shape == FULL_COARSE.mesh.t.shape
     finally:
         path.unlink(missing_ok=True)
 
 
 @settings(max_examples=20, deadline=None, derandomize=True)
-@given(radius=st.floats(0.2, 1.95), shift=st.floats(-0.5, 0.5), refine=st.integers(1, 3),
-       hole=st.booleans(), fmt=st.sampled_from([".msh", ".vtu"]))
+@given(
+    radius=st.floats(0.2, 1.95),
+    shift=st.floats(-0.5, 0.5),
+    refine=st.integers(1, 3),
+    hole=st.booleans(),
+    fmt=st.sampled_from([".msh", ".vtu"]),
+)
 def test_mesh_that_does_not_cover_the_domain(radius, shift, refine, hole, fmt):
     """A disk smaller than L (the contact is not covered), shifted, or with a hole: MeshError."""
     import meshio
@@ -366,14 +408,17 @@ def test_mesh_that_does_not_cover_the_domain(radius, shift, refine, hole, fmt):
     p = m.p * radius
     p[0] += shift
     t = m.t
-    if hole:                                               # drop the triangles near the centre
+    if hole:  # drop the triangles near the centre
         c = p[:, t].mean(axis=1)
         t = t[:, np.hypot(c[0] - shift, c[1]) > 0.3 * radius]
     path = _scene_file(b"", fmt)
     try:
         pts = np.column_stack([p.T, np.zeros(p.shape[1])])
-        meshio.write(path, meshio.Mesh(pts, [("triangle", t.T)]),
-                     **({"file_format": "gmsh22", "binary": False} if fmt == ".msh" else {}))
+        meshio.write(
+            path,
+            meshio.Mesh(pts, [("triangle", t.T)]),
+            **({"file_format": "gmsh22", "binary": False} if fmt == ".msh" else {}),
+        )
         with pytest.raises(MeshError) as info:
             load_mesh(path, L=2.0)
         assert_documented(info.value)
@@ -391,18 +436,34 @@ FORMER_ESCAPES = [
     pytest.param(lambda: Domain("2").L * 1.0, id="Domain(L='2') accepted, stored as str"),
     pytest.param(lambda: HalfSpace("0.3").compliance, id="HalfSpace(nu='0.3') accepted, TypeError"),
     pytest.param(lambda: Fluid(10**400), id="Fluid(10**400) OverflowError"),
-    pytest.param(lambda: femehl.solve(Scene(substrate=Rigid(), fluid=Fluid(5e-324),
-                                            motion=Motion(gap=RampHold(1.0, 0.5, 1.0))),
-                                      "fd", t_end=0.2, dt=0.1, dr=0.2, dtheta=math.pi / 8),
-                 id="FD sparse singular system: RuntimeError from spsolve"),
+    pytest.param(
+        lambda: femehl.solve(
+            Scene(substrate=Rigid(), fluid=Fluid(5e-324), motion=Motion(gap=RampHold(1.0, 0.5, 1.0))),
+            "fd",
+            t_end=0.2,
+            dt=0.1,
+            dr=0.2,
+            dtheta=math.pi / 8,
+        ),
+        id="FD sparse singular system: RuntimeError from spsolve",
+    ),
     pytest.param(lambda: check_run(49.0, 2.7e-307), id="check_run(49, 2.7e-307) OverflowError"),
-    pytest.param(lambda: femehl.make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse",
-                                             scheme=[1.0]), id="FE scheme=[1.0] TypeError (unhashable)"),
-    pytest.param(lambda: femehl.make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse",
-                                             linear_solver=np.array([1.0, 2.0])),
-                 id="FE linear_solver=array ValueError"),
-    pytest.param(lambda: femehl.make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse",
-                                             half=np.array([1.0, 2.0])), id="FE half=array ValueError"),
+    pytest.param(
+        lambda: femehl.make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse", scheme=[1.0]),
+        id="FE scheme=[1.0] TypeError (unhashable)",
+    ),
+    pytest.param(
+        lambda: femehl.make_stepper(
+            femehl.presets.paper_sphere(), "fe", mesh="coarse", linear_solver=np.array([1.0, 2.0])
+        ),
+        id="FE linear_solver=array ValueError",
+    ),
+    pytest.param(
+        lambda: femehl.make_stepper(
+            femehl.presets.paper_sphere(), "fe", mesh="coarse", half=np.array([1.0, 2.0])
+        ),
+        id="FE half=array ValueError",
+    ),
 ]
 
 

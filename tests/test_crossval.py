@@ -8,7 +8,7 @@ start-up (its forward differences are downwind at the exit); FE on the
 "medium" mesh.
 
 Tolerances come from the refinement studies of each solver (figures measured
-on this machine, recorded in the closing note of issue 4):
+on this machine):
 
 * FE along the ladder coarse -> medium -> fine changes load by < 0.03 %,
   central film by < 0.2 %, minimum film by < 1 % (t = 2), so the FE values are

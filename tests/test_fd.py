@@ -23,11 +23,21 @@ def FDStep(scene, **kw):
     return make_stepper(scene, "fd", **kw)
 from femehl.presets import paper_sphere
 from femehl.scene import (
-    Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Table, Winkler,
+    Dimensional,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Sphere,
+    Table,
+    Winkler,
 )
 
-F_HERTZ = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (design.md s. 2)
-P0_HERTZ = 2.0 / math.pi ** 2         # normalized Hertz central pressure
+F_HERTZ = 4.0 / (3.0 * math.pi)  # normalized Hertz load at hc = -1 (docs/design.md, section 2)
+P0_HERTZ = 2.0 / math.pi**2  # normalized Hertz central pressure
 
 
 # ---------------------------------------------------------------------------
@@ -46,13 +56,13 @@ P0_HERTZ = 2.0 / math.pi ** 2         # normalized Hertz central pressure
 
 def rigid_exact_load(hc, hdot, beta, L):
     uL = hc + 0.5 * L * L
-    return -hdot * math.pi / (2.0 * beta) * (1.0 / hc - 1.0 / uL - (uL - hc) / uL ** 2)
+    return -hdot * math.pi / (2.0 * beta) * (1.0 / hc - 1.0 / uL - (uL - hc) / uL**2)
 
 
 def rigid_exact_pressure(r, hc, hdot, beta, L):
     uL = hc + 0.5 * L * L
     u = hc + 0.5 * r * r
-    return -hdot / (4.0 * beta) * (1.0 / u ** 2 - 1.0 / uL ** 2)
+    return -hdot / (4.0 * beta) * (1.0 / u**2 - 1.0 / uL**2)
 
 
 def reynolds_thin_gap_load(hc, hdot, beta):
@@ -61,18 +71,22 @@ def reynolds_thin_gap_load(hc, hdot, beta):
 
 
 RIGID_BETA = 1.0
-RIGID_HDOT = -0.8                      # RampHold(1.0 -> 0.2 over t in [0, 1])
+RIGID_HDOT = -0.8  # RampHold(1.0 -> 0.2 over t in [0, 1])
 
 
 def rigid_scene(L=2.0):
-    return Scene(indenter=Sphere(), substrate=Rigid(), fluid=Fluid(RIGID_BETA),
-                 motion=Motion(gap=RampHold(h0=1.0, h_end=0.2, t1=1.0), velocity=0.0),
-                 domain=Domain(L))
+    return Scene(
+        indenter=Sphere(),
+        substrate=Rigid(),
+        fluid=Fluid(RIGID_BETA),
+        motion=Motion(gap=RampHold(h0=1.0, h_end=0.2, t1=1.0), velocity=0.0),
+        domain=Domain(L),
+    )
 
 
 def test_rigid_scene_is_valid_and_sparse():
     """Scene validation allows hc > 0 throughout (no contact, no domain check), and a rigid
-    substrate builds no dense operator (design.md section 6)."""
+    substrate builds no dense operator (docs/design.md, section 6)."""
     sc = rigid_scene()
     eff = sc.effects(1.0)
     assert eff["squeeze"] and not eff["sliding"] and eff["elasticity"] == "rigid"
@@ -86,8 +100,10 @@ def test_rigid_scene_is_valid_and_sparse():
 def rigid_runs():
     """(dr, dt) = (0.1, 0.02) and (0.05, 0.01), dtheta = pi/24."""
     sc = rigid_scene()
-    return {(dr, dt): api.solve(sc, "fd", t_end=1.0, dt=dt, dr=dr, dtheta=math.pi / 24)
-            for dr, dt in ((0.1, 0.02), (0.05, 0.01))}
+    return {
+        (dr, dt): api.solve(sc, "fd", t_end=1.0, dt=dt, dr=dr, dtheta=math.pi / 24)
+        for dr, dt in ((0.1, 0.02), (0.05, 0.01))
+    }
 
 
 def _rigid_errors(res):
@@ -165,15 +181,15 @@ def test_rigid_thin_gap_reynolds(rigid_runs):
     hc, beta = 0.2, RIGID_BETA
     F_R = reynolds_thin_gap_load(hc, RIGID_HDOT, beta)
     F_ex = rigid_exact_load(hc, RIGID_HDOT, beta, 2.0)
-    corr = hc * (1 / 2.2 + 2.0 / 2.2 ** 2)
+    corr = hc * (1 / 2.2 + 2.0 / 2.2**2)
     assert 1 - F_ex / F_R == pytest.approx(corr, rel=1e-12)
-    assert corr == pytest.approx(0.17355, abs=1e-5) and corr < 4 * hc / 2.0 ** 2
+    assert corr == pytest.approx(0.17355, abs=1e-5) and corr < 4 * hc / 2.0**2
     res = rigid_runs[0.05, 0.01]
     F_fd = res.value_at("load", 1.0)
     assert F_fd / F_R == pytest.approx(1 - corr, rel=0.025)
     # L = 4: closer to Reynolds
     F_ex4 = rigid_exact_load(hc, RIGID_HDOT, beta, 4.0)
-    assert 1 - F_ex4 / F_R == pytest.approx(0.2 * (1 / 8.2 + 8 / 8.2 ** 2), rel=1e-12)
+    assert 1 - F_ex4 / F_R == pytest.approx(0.2 * (1 / 8.2 + 8 / 8.2**2), rel=1e-12)
     assert abs(1 - F_ex4 / F_R) < abs(1 - F_ex / F_R) / 3
 
 
@@ -188,12 +204,13 @@ def test_reynolds_law_conversion():
     scales against a textbook law.
     """
     dim = Dimensional(R=4e-3, G=3e5, eta=0.05, V_ss=2e-3, h_inf=1e-5)
-    hc, hdot = 0.3, -0.7                              # normalized
+    hc, hdot = 0.3, -0.7  # normalized
     h_si = dim.to_si("height", hc)
     hdot_si = hdot * dim.height / dim.time
-    F_si = 6 * math.pi * dim.eta * dim.R ** 2 * abs(hdot_si) / h_si
+    F_si = 6 * math.pi * dim.eta * dim.R**2 * abs(hdot_si) / h_si
     assert float(dim.from_si("force", F_si)) == pytest.approx(
-        reynolds_thin_gap_load(hc, hdot, dim.beta), rel=1e-12)
+        reynolds_thin_gap_load(hc, hdot, dim.beta), rel=1e-12
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -202,9 +219,12 @@ def test_reynolds_law_conversion():
 
 @pytest.fixture(scope="module")
 def hertz_hold():
-    sc = Scene(substrate=HalfSpace(0.5), fluid=Fluid(200.0),
-               motion=Motion(gap=Table([0.0, 1.0, 6.0], [0.1, -1.0, -1.0]), velocity=0.0),
-               domain=Domain(2.0))
+    sc = Scene(
+        substrate=HalfSpace(0.5),
+        fluid=Fluid(200.0),
+        motion=Motion(gap=Table([0.0, 1.0, 6.0], [0.1, -1.0, -1.0]), velocity=0.0),
+        domain=Domain(2.0),
+    )
     return api.solve(sc, "fd", t_end=6.0, dt=0.05, dr=0.05, dtheta=math.pi / 12, store_every=20)
 
 
@@ -226,7 +246,7 @@ def test_hertz_limit_hold(hertz_hold):
     assert s.t == 6.0 and s.hc == -1.0
     assert 0.0 < load[-1] / F_HERTZ - 1.0 < 0.06
     assert 0.0 < s.p[0] / P0_HERTZ - 1.0 < 0.03
-    assert s.p_max_at == pytest.approx((0.0, 0.0), abs=1e-12)     # axisymmetric, peak at the tip
+    assert s.p_max_at == pytest.approx((0.0, 0.0), abs=1e-12)  # axisymmetric, peak at the tip
 
 
 def test_hertz_limit_effective_indentation(hertz_hold):
@@ -243,9 +263,9 @@ def test_hertz_limit_effective_indentation(hertz_hold):
     res = hertz_hold
     s = res.states[-1]
     delta = 1.0 + s.film_center
-    assert -s.w[0] == pytest.approx(delta, abs=1e-12)       # d = hc + s - w at r = 0
-    assert s.load == pytest.approx(F_HERTZ * delta ** 1.5, rel=0.025)
-    assert s.p[0] == pytest.approx(P0_HERTZ * delta ** 0.5, rel=0.015)
+    assert -s.w[0] == pytest.approx(delta, abs=1e-12)  # d = hc + s - w at r = 0
+    assert s.load == pytest.approx(F_HERTZ * delta**1.5, rel=0.025)
+    assert s.p[0] == pytest.approx(P0_HERTZ * delta**0.5, rel=0.015)
     r = np.linspace(0.0, 0.7, 15)
     for th in (0.0, 1.0, 2.5):
         pts = np.column_stack([r * math.cos(th), r * math.sin(th)])
@@ -287,10 +307,15 @@ def test_hertz_pressure_on_grid_reference():
 def indentation_runs():
     sc = paper_sphere()
     runs = {}
-    for dr, dt, n in ((0.1, 0.04, 12), (0.05, 0.04, 12), (0.025, 0.04, 12),
-                      (0.05, 0.02, 12), (0.05, 0.01, 12), (0.05, 0.04, 24)):
-        runs[dr, dt, n] = api.solve(sc, "fd", t_end=1.0, dt=dt, dr=dr, dtheta=math.pi / n,
-                                    store_every=1000)
+    for dr, dt, n in (
+        (0.1, 0.04, 12),
+        (0.05, 0.04, 12),
+        (0.025, 0.04, 12),
+        (0.05, 0.02, 12),
+        (0.05, 0.01, 12),
+        (0.05, 0.04, 24),
+    ):
+        runs[dr, dt, n] = api.solve(sc, "fd", t_end=1.0, dt=dt, dr=dr, dtheta=math.pi / n, store_every=1000)
     return runs
 
 
@@ -367,8 +392,7 @@ def test_axisymmetry_defect_is_second_order_in_dtheta(indentation_runs):
         assert s.t == 1.0
         g = res.disc.grid
         D, P = s.d.reshape(g.m, g.n), s.p.reshape(g.m, g.n)
-        defects.append((np.abs(D - D.mean(axis=0)).max(), np.abs(P - P.mean(axis=0)).max(),
-                        s.film_center))
+        defects.append((np.abs(D - D.mean(axis=0)).max(), np.abs(P - P.mean(axis=0)).max(), s.film_center))
     (d12, p12, fc), (d24, p24, _) = defects
     assert d12 < 0.03 * fc
     assert d12 / d24 > 3 and p12 / p24 > 3
@@ -380,15 +404,14 @@ def test_axisymmetry_defect_is_second_order_in_dtheta(indentation_runs):
 
 @pytest.fixture(scope="module")
 def paper_t2():
-    return api.solve(paper_sphere(), "fd", t_end=2.0, dt=0.01, dr=0.025, dtheta=math.pi / 36,
-                     store_every=100)
+    return api.solve(paper_sphere(), "fd", t_end=2.0, dt=0.01, dr=0.025, dtheta=math.pi / 36, store_every=100)
 
 
 @pytest.mark.slow
 def test_paper_exit_constriction(paper_t2):
     """Paper case at t = 2 (V = tanh 1 = 0.76), dr = 0.025, dtheta = pi/36 (~3 min).
 
-    The substrate moves toward -x, so the exit is at x < 0 (design.md s. 1).
+    The substrate moves toward -x, so the exit is at x < 0 (docs/design.md, section 1).
     Checked: the global film minimum is on the exit side (observed
     (-0.34, 0.94), a side lobe of the horseshoe); on the centreline the film
     minimum (the constriction) lies at -1.15 < x < -0.85 (observed -1.075);
@@ -399,7 +422,7 @@ def test_paper_exit_constriction(paper_t2):
     exceeds the inlet-side value (0.093 vs 0.069), the asymmetry that builds
     the spike.  At beta = 200 and this resolution the exit "spike" is a shoulder
     above the Hertz pressure, not a local maximum: the FE solver on finer meshes
-    gives the same monotone fall (see the closing note of issue 3).
+    gives the same monotone fall.
     """
     res = paper_t2
     s = res.state_at(2.0)
@@ -410,7 +433,7 @@ def test_paper_exit_constriction(paper_t2):
     assert -1.15 < x[np.argmin(d)] < -0.85
     exit_ = (x < -0.5) & (x > -1.4)
     xe, pe = x[exit_], p[exit_]
-    slope = np.diff(pe) / np.diff(xe)                      # dp/dx > 0 where p falls toward -x
+    slope = np.diff(pe) / np.diff(xe)  # dp/dx > 0 where p falls toward -x
     xmid = 0.5 * (xe[1:] + xe[:-1])
     assert -1.15 < xmid[np.argmax(slope)] < -0.85
     assert p.min() < 0.0 and -1.3 < x[np.argmin(p)] < -1.0
@@ -422,18 +445,21 @@ def test_paper_exit_constriction(paper_t2):
 # bad input
 
 
-@pytest.mark.parametrize("opts, msg", [
-    (dict(dr=0.0), r"dr must be > 0"),
-    (dict(dr=-0.05), r"dr must be > 0"),
-    (dict(dr=math.nan), r"dr must be finite"),
-    (dict(dr=0.3), r"L/dr = 6\.66667 must be an integer.*pick dr = L/n"),
-    (dict(dr=1.0), r"must be an integer >= 4"),
-    (dict(dtheta=0.3), r"pi/dtheta = .* must be an integer.*pick dtheta = pi/n"),
-    (dict(dtheta=0.0), r"dtheta must be > 0"),
-    (dict(dtheta=math.inf), r"dtheta must be finite"),
-    (dict(mesh="coarse"), r"method 'fd' does not take \['mesh'\]"),
-    (dict(dx=0.1), r"does not take \['dx'\]"),
-])
+@pytest.mark.parametrize(
+    "opts, msg",
+    [
+        (dict(dr=0.0), r"dr must be > 0"),
+        (dict(dr=-0.05), r"dr must be > 0"),
+        (dict(dr=math.nan), r"dr must be finite"),
+        (dict(dr=0.3), r"L/dr = 6\.66667 must be an integer.*pick dr = L/n"),
+        (dict(dr=1.0), r"must be an integer >= 4"),
+        (dict(dtheta=0.3), r"pi/dtheta = .* must be an integer.*pick dtheta = pi/n"),
+        (dict(dtheta=0.0), r"dtheta must be > 0"),
+        (dict(dtheta=math.inf), r"dtheta must be finite"),
+        (dict(mesh="coarse"), r"method 'fd' does not take \['mesh'\]"),
+        (dict(dx=0.1), r"does not take \['dx'\]"),
+    ],
+)
 def test_bad_fd_options(opts, msg):
     with pytest.raises(SceneError, match=msg):
         api.solve(paper_sphere(), "fd", t_end=0.1, dt=0.05, **opts)
@@ -441,14 +467,17 @@ def test_bad_fd_options(opts, msg):
         next(api.steps(paper_sphere(), 0.1, 0.05, "fd", **opts))
 
 
-@pytest.mark.parametrize("t_end, dt, msg", [
-    (1.0, 0.0, r"dt must be > 0"),
-    (1.0, -0.01, r"dt must be > 0"),
-    (1.0, math.nan, r"dt must be finite"),
-    (0.0, 0.01, r"t_end must be > 0"),
-    (-1.0, 0.01, r"t_end must be > 0"),
-    (0.1, 0.2, r"larger than t_end"),
-])
+@pytest.mark.parametrize(
+    "t_end, dt, msg",
+    [
+        (1.0, 0.0, r"dt must be > 0"),
+        (1.0, -0.01, r"dt must be > 0"),
+        (1.0, math.nan, r"dt must be finite"),
+        (0.0, 0.01, r"t_end must be > 0"),
+        (-1.0, 0.01, r"t_end must be > 0"),
+        (0.1, 0.2, r"larger than t_end"),
+    ],
+)
 def test_bad_run_parameters(t_end, dt, msg):
     with pytest.raises(SceneError, match=msg):
         api.solve(paper_sphere(), "fd", t_end=t_end, dt=dt, dr=0.5)
@@ -464,10 +493,14 @@ def test_unknown_method():
 def test_fd_rejects_indenter_not_symmetric_in_y():
     from femehl.indenters import Shape
 
-    shape = Shape(lambda x, y: 0.5 * (x * x + y * y) + 0.3 * np.maximum(y, 0.0) ** 2,
-                  symmetric_y=False)
-    sc = Scene(indenter=shape, substrate=Rigid(), fluid=Fluid(1.0),
-               motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=0.0), domain=Domain(2.0))
+    shape = Shape(lambda x, y: 0.5 * (x * x + y * y) + 0.3 * np.maximum(y, 0.0) ** 2, symmetric_y=False)
+    sc = Scene(
+        indenter=shape,
+        substrate=Rigid(),
+        fluid=Fluid(1.0),
+        motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=0.0),
+        domain=Domain(2.0),
+    )
     with pytest.raises(SceneError, match=r"symmetric"):
         FDStep(sc, dr=0.1, dtheta=math.pi / 6)
 

@@ -22,8 +22,9 @@ TOML = ROOT / "examples" / "cylinder_winkler.toml"
 def test_toml_gives_the_example_scene():
     scene, run = load_scene_file(TOML)
     # examples/cylinder_winkler.py main() defaults
-    expected = LineScene(k=1.0, beta=10.0, L=2.0,
-                         motion=Motion(gap=RampHold(0.1, -0.5, 1.0), velocity=TanhStart(1.0, 1.0)))
+    expected = LineScene(
+        k=1.0, beta=10.0, L=2.0, motion=Motion(gap=RampHold(0.1, -0.5, 1.0), velocity=TanhStart(1.0, 1.0))
+    )
     assert isinstance(scene, LineScene)
     assert scene == expected
     assert run == {"n_elements": 400, "dt": 0.05, "t_end": 15.0, "store_every": 10}
@@ -93,8 +94,9 @@ def test_unknown_run_key_is_refused(tmp_path, capsys):
     assert "mesh" in err and "n_elements" in err
 
 
-@pytest.mark.parametrize("extra", [["--mesh", "coarse"], ["--dr", "0.1"], ["--dtheta-divisions", "8"],
-                                   ["--method", "fe"]])
+@pytest.mark.parametrize(
+    "extra", [["--mesh", "coarse"], ["--dr", "0.1"], ["--dtheta-divisions", "8"], ["--method", "fe"]]
+)
 def test_2d_options_are_refused(tmp_path, capsys, extra):
     rc = main(["run", str(TOML), "--t-end", "0.1", "--out", str(tmp_path / "o"), "--quiet"] + extra)
     assert rc == 2
@@ -104,7 +106,8 @@ def test_2d_options_are_refused(tmp_path, capsys, extra):
 
 def test_radius_other_than_one_is_refused(tmp_path):
     text = SCENE.format(substrate='kind = "winkler"\nk = 1.0', run="").replace(
-        'kind = "cylinder"', 'kind = "cylinder"\nR = 2.0')
+        'kind = "cylinder"', 'kind = "cylinder"\nR = 2.0'
+    )
     with pytest.raises(SceneFileError, match="R must be 1"):
         load_scene_file(_write(tmp_path, text))
     text1 = text.replace("R = 2.0", "R = 1.0")

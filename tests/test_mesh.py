@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import meshio
@@ -88,10 +89,10 @@ def test_ladder_counts_double(ladder, half):
     ratios = ne[1:] / ne[:-1]
     assert np.all((ratios > 1.8) & (ratios < 2.3)), ratios
     if half:
-        for n, lo, hi in zip(NAMES, (1000, 2500, 6000, 12000), (1500, 3500, 8000, 16000)):
+        for n, lo, hi in zip(NAMES, (1000, 2500, 6000, 12000), (1500, 3500, 8000, 16000), strict=True):
             assert lo <= ladder[n, True].mesh.t.shape[1] <= hi
     # sizes: every rung divides all three by the same factor ~ sqrt(2)
-    for a, b in zip(NAMES, NAMES[1:]):
+    for a, b in itertools.pairwise(NAMES):
         for k in ("h_far", "h_contact", "h_edge"):
             assert LADDER[a][k] / LADDER[b][k] == pytest.approx(fm.LADDER_RATIO, rel=1e-4)
     assert 1.35 < fm.LADDER_RATIO < 1.5

@@ -22,13 +22,16 @@ def _read_csv(path):
     return rows[0], np.array(rows[1:], dtype=float)
 
 
-@pytest.mark.parametrize("method,opts", [("fe", dict(mesh="coarse")),
-                                         ("fd", dict(dr=0.1, dtheta=math.pi / 12))])
+@pytest.mark.parametrize(
+    "method,opts", [("fe", dict(mesh="coarse")), ("fd", dict(dr=0.1, dtheta=math.pi / 12))]
+)
 def test_run_writes_readable_series(tmp_path, method, opts):
     """Every stored state is a .vtu meshio reads back with the fields it had; the .pvd
     lists them with their times; the CSV has one row per step and matches the Result."""
     sc = femehl.presets.paper_sphere()
-    res = run_to_folder(sc, tmp_path, method=method, t_end=0.3, dt=0.05, store_every=2, log=lambda *a: None, **opts)
+    res = run_to_folder(
+        sc, tmp_path, method=method, t_end=0.3, dt=0.05, store_every=2, log=lambda *a: None, **opts
+    )
     head, data = _read_csv(tmp_path / "summary.csv")
     assert tuple(head) == COLUMNS
     assert data.shape[0] == res.nsteps + 1 == 7
@@ -37,7 +40,7 @@ def test_run_writes_readable_series(tmp_path, method, opts):
     sets = root.findall("./Collection/DataSet")
     times = [float(s.get("timestep")) for s in sets]
     assert np.allclose(times, [0.0, 0.1, 0.2, 0.3])
-    for s, t in zip(sets, times):
+    for s, t in zip(sets, times, strict=True):
         m = meshio.read(tmp_path / s.get("file"))
         st = res.state_at(t)
         assert np.allclose(m.point_data["pressure"], st.p)
@@ -51,7 +54,9 @@ def test_series_readable_by_pyvista(tmp_path):
     """ParaView/pyvista open the .pvd index (pyvista is optional: skipped if absent)."""
     pv = pytest.importorskip("pyvista")
     sc = femehl.presets.paper_sphere()
-    run_to_folder(sc, tmp_path, method="fe", mesh="coarse", t_end=0.2, dt=0.1, store_every=1, log=lambda *a: None)
+    run_to_folder(
+        sc, tmp_path, method="fe", mesh="coarse", t_end=0.2, dt=0.1, store_every=1, log=lambda *a: None
+    )
     reader = pv.get_reader(str(tmp_path / "fields.pvd"))
     assert np.allclose(reader.time_values, [0.0, 0.1, 0.2])
     reader.set_active_time_value(0.2)
@@ -62,7 +67,9 @@ def test_series_readable_by_pyvista(tmp_path):
 
 def test_cli_default_scene_short(tmp_path, capsys):
     """`femehl run` on the built-in scene (shortened) prints the figures it wrote."""
-    rc = main(["run", "--t-end", "0.2", "--dt", "0.05", "--mesh", "coarse", "--out", str(tmp_path), "--quiet"])
+    rc = main(
+        ["run", "--t-end", "0.2", "--dt", "0.05", "--mesh", "coarse", "--out", str(tmp_path), "--quiet"]
+    )
     assert rc == 0
     cap = capsys.readouterr()
     # sliding starts at t = 1: a run to t = 0.2 has no Couette term (the run's report: stderr)
@@ -73,8 +80,25 @@ def test_cli_default_scene_short(tmp_path, capsys):
 
 def test_cli_scene_file_and_fd(tmp_path, capsys):
     """The commented example scene file runs, with --method fd overriding [run]."""
-    rc = main(["run", "examples/paper_sphere.toml", "--method", "fd", "--dr", "0.1",
-               "--dtheta-divisions", "12", "--t-end", "0.1", "--dt", "0.05", "--out", str(tmp_path), "--quiet"])
+    rc = main(
+        [
+            "run",
+            "examples/paper_sphere.toml",
+            "--method",
+            "fd",
+            "--dr",
+            "0.1",
+            "--dtheta-divisions",
+            "12",
+            "--t-end",
+            "0.1",
+            "--dt",
+            "0.05",
+            "--out",
+            str(tmp_path),
+            "--quiet",
+        ]
+    )
     assert rc == 0
     head, data = _read_csv(tmp_path / "summary.csv")
     assert data.shape[0] == 3
@@ -93,6 +117,7 @@ def test_cli_bad_input_exit_code(tmp_path, capsys):
 def test_user_mesh_file(tmp_path):
     """Any mesh meshio reads is accepted (here a .vtu of the coarse ladder mesh)."""
     from femehl.fe.mesh import load_mesh
+
     dm = load_mesh("coarse")
     path = tmp_path / "mine.vtu"
     meshio.write(path, meshio.Mesh(dm.mesh.p.T, [("triangle", dm.mesh.t.T)]))
@@ -110,8 +135,8 @@ def test_result_interpolation_in_time():
     mid = r.pressure_at(pts, 0.25)
     lo, hi = r.pressure_at(pts, 0.2), r.pressure_at(pts, 0.3)
     assert np.allclose(mid, 0.5 * (lo + hi))
-    assert mid[2] == 0.0                                   # outside the domain: p = 0
-    assert np.isclose(r.pressure_at(pts[:2] * [1, -1], 0.3)[1], hi[1])   # mirror symmetry
+    assert mid[2] == 0.0  # outside the domain: p = 0
+    assert np.isclose(r.pressure_at(pts[:2] * [1, -1], 0.3)[1], hi[1])  # mirror symmetry
     with pytest.raises(femehl.SceneError, match="outside the stored times"):
         r.pressure_at(pts, 0.5)
     with pytest.raises(femehl.SceneError, match=r"shape \(n, 2\)"):

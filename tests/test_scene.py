@@ -21,8 +21,19 @@ from femehl import api
 from femehl.errors import FilmRuptureError, SceneError, SolverError
 from femehl.presets import paper_sphere
 from femehl.scene import (
-    Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Table,
-    TanhStart, Winkler,
+    Constant,
+    Dimensional,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Sphere,
+    Table,
+    TanhStart,
+    Winkler,
 )
 from femehl.stepping import State, check_run, march
 
@@ -84,7 +95,7 @@ def test_poisson_ratio_out_of_range(nu):
 
 @pytest.mark.parametrize("nu", [0.5, 0.3, 0.0, -0.99])
 def test_poisson_ratio_in_range(nu):
-    """compliance 2(1 - nu): the factor 1/G -> 2(1 - nu)/G of design.md section 1."""
+    """compliance 2(1 - nu): the factor 1/G -> 2(1 - nu)/G of docs/design.md, section 1."""
     assert HalfSpace(nu).compliance == pytest.approx(2 * (1 - nu))
 
 
@@ -92,13 +103,14 @@ def test_domain_too_small_for_contact():
     """hc = -1 makes a Hertz contact of radius sqrt(R |hc|) = 1; L = 1.2 < 1.5 a is refused."""
     with pytest.raises(SceneError, match=r"too small to hold the contact.*Use L >= 1\.5"):
         paper_sphere(L=1.2)
-    paper_sphere(L=1.55)         # just above the limit 1.5 is accepted
+    paper_sphere(L=1.55)  # just above the limit 1.5 is accepted
 
 
 def test_domain_check_only_for_indentation():
     """A run that never indents (hc >= 0) accepts a small domain."""
-    sc = Scene(substrate=Rigid(), motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=0.0),
-               domain=Domain(0.5))
+    sc = Scene(
+        substrate=Rigid(), motion=Motion(gap=RampHold(1.0, 0.2, 1.0), velocity=0.0), domain=Domain(0.5)
+    )
     assert sc.domain.L == 0.5
 
 
@@ -108,16 +120,19 @@ def test_domain_radius(L):
         Domain(L)
 
 
-@pytest.mark.parametrize("times, values, msg", [
-    ([], [], r"Table is empty: give at least one"),
-    ([0.0, 1.0, 1.0], [0.1, 0.0, -1.0], r"strictly increasing: sort the rows"),
-    ([0.0, 2.0, 1.0], [0.1, 0.0, -1.0], r"strictly increasing"),
-    ([0.0, math.nan], [0.1, -1.0], r"finite \(no NaN or inf\)"),
-    ([0.0, 1.0], [0.1, math.nan], r"finite \(no NaN or inf\)"),
-    ([0.0, 1.0], [0.1, math.inf], r"finite"),
-    ([0.0, 1.0, 2.0], [0.1, -1.0], r"3 times but 2 values: give one value per time"),
-    (["a", "b"], [0.1, 0.2], r"must hold real numbers"),
-])
+@pytest.mark.parametrize(
+    "times, values, msg",
+    [
+        ([], [], r"Table is empty: give at least one"),
+        ([0.0, 1.0, 1.0], [0.1, 0.0, -1.0], r"strictly increasing: sort the rows"),
+        ([0.0, 2.0, 1.0], [0.1, 0.0, -1.0], r"strictly increasing"),
+        ([0.0, math.nan], [0.1, -1.0], r"finite \(no NaN or inf\)"),
+        ([0.0, 1.0], [0.1, math.nan], r"finite \(no NaN or inf\)"),
+        ([0.0, 1.0], [0.1, math.inf], r"finite"),
+        ([0.0, 1.0, 2.0], [0.1, -1.0], r"3 times but 2 values: give one value per time"),
+        (["a", "b"], [0.1, 0.2], r"must hold real numbers"),
+    ],
+)
 def test_table_invalid(times, values, msg):
     with pytest.raises(SceneError, match=msg):
         Table(times, values)
@@ -146,10 +161,13 @@ def test_time_function_returning_nan():
         Scene(motion=Motion(gap=lambda t: math.nan))
 
 
-@pytest.mark.parametrize("kw, msg", [
-    (dict(t1=0.0), r"t1 \(end of the ramp\) must be > 0"),
-    (dict(h0=math.nan), r"h0 must be finite"),
-])
+@pytest.mark.parametrize(
+    "kw, msg",
+    [
+        (dict(t1=0.0), r"t1 \(end of the ramp\) must be > 0"),
+        (dict(h0=math.nan), r"h0 must be finite"),
+    ],
+)
 def test_rampHold_invalid(kw, msg):
     with pytest.raises(SceneError, match=msg):
         RampHold(**kw)
@@ -198,7 +216,7 @@ def test_dimensional_beta_by_hand():
     dim = Dimensional(**SI)
     assert dim.beta == pytest.approx(160 * math.pi / 3, rel=1e-14)
     # the other scales of Eq. 8
-    assert dim.length == pytest.approx(math.sqrt(1e-7), rel=1e-14)          # sqrt(R h_inf)
+    assert dim.length == pytest.approx(math.sqrt(1e-7), rel=1e-14)  # sqrt(R h_inf)
     assert dim.height == 2e-5
     assert dim.time == pytest.approx(2 * math.sqrt(1e-7) / 1e-3, rel=1e-14)  # 2 sqrt(R h_inf)/V
     assert dim.pressure == pytest.approx(4 * math.pi * 1e5 * math.sqrt(2e-5 / 5e-3), rel=1e-14)
@@ -206,14 +224,14 @@ def test_dimensional_beta_by_hand():
 
 
 def test_dimensional_hertz_consistency():
-    """design.md section 7: F = (16/3) G sqrt(R) delta^(3/2) at delta = h_inf must be the
+    """docs/design.md, section 7: F = (16/3) G sqrt(R) delta^(3/2) at delta = h_inf must be the
     normalized Hertz load 4/(3 pi) times the force scale, and p0 = (8 G/pi) sqrt(delta/R)
     must be 2/pi^2 times the pressure scale.  Checks the scales against an independent law."""
     dim = Dimensional(**SI)
     F_si = 16 / 3 * SI["G"] * math.sqrt(SI["R"]) * SI["h_inf"] ** 1.5
     p0_si = 8 * SI["G"] / math.pi * math.sqrt(SI["h_inf"] / SI["R"])
     assert float(dim.from_si("force", F_si)) == pytest.approx(4 / (3 * math.pi), rel=1e-13)
-    assert float(dim.from_si("pressure", p0_si)) == pytest.approx(2 / math.pi ** 2, rel=1e-13)
+    assert float(dim.from_si("pressure", p0_si)) == pytest.approx(2 / math.pi**2, rel=1e-13)
 
 
 @pytest.mark.parametrize("q", ["length", "height", "time", "pressure", "force", "velocity"])
@@ -243,14 +261,17 @@ def test_dimensional_scene():
     assert sc2.motion.hc(1.0) == pytest.approx(-1.0) and sc2.domain.L == 2.0
 
 
-@pytest.mark.parametrize("key, value, msg", [
-    ("R", -1.0, r"R \[SI\] must be > 0"),
-    ("G", 0.0, r"G \[SI\] must be > 0"),
-    ("eta", math.nan, r"eta \[SI\] must be finite"),
-    ("V_ss", -1e-3, r"V_ss \[SI\] must be > 0"),
-    ("h_inf", math.inf, r"h_inf \[SI\] must be finite"),
-    ("nu", 0.7, r"Poisson ratio nu must lie in"),
-])
+@pytest.mark.parametrize(
+    "key, value, msg",
+    [
+        ("R", -1.0, r"R \[SI\] must be > 0"),
+        ("G", 0.0, r"G \[SI\] must be > 0"),
+        ("eta", math.nan, r"eta \[SI\] must be finite"),
+        ("V_ss", -1e-3, r"V_ss \[SI\] must be > 0"),
+        ("h_inf", math.inf, r"h_inf \[SI\] must be finite"),
+        ("nu", 0.7, r"Poisson ratio nu must lie in"),
+    ],
+)
 def test_dimensional_invalid(key, value, msg):
     kw = dict(SI)
     kw[key] = value
@@ -318,9 +339,21 @@ class StubStepper:
 
     def _state(self, step, t):
         z = np.zeros(1)
-        return State(step=step, t=t, hc=0.0, V=0.0, p=z, w=z, d=z + self.film(t), load=0.0,
-                     film_center=self.film(t), film_min=self.film(t), film_min_at=(0.0, 0.0),
-                     p_max=0.0, p_max_at=(0.0, 0.0))
+        return State(
+            step=step,
+            t=t,
+            hc=0.0,
+            V=0.0,
+            p=z,
+            w=z,
+            d=z + self.film(t),
+            load=0.0,
+            film_center=self.film(t),
+            film_min=self.film(t),
+            film_min_at=(0.0, 0.0),
+            p_max=0.0,
+            p_max_at=(0.0, 0.0),
+        )
 
     def initial_state(self):
         return self._state(0, 0.0)
@@ -339,8 +372,9 @@ def test_march_initial_then_one_per_step():
     assert len(stub.calls) == 4
 
 
-@pytest.mark.parametrize("t_end, dt, n", [(1.0, 0.3, 4), (0.7, 0.2, 4), (1.0, 0.4, 3),
-                                          (0.3, 0.1, 3), (2.0, 0.7, 3)])
+@pytest.mark.parametrize(
+    "t_end, dt, n", [(1.0, 0.3, 4), (0.7, 0.2, 4), (1.0, 0.4, 3), (0.3, 0.1, 3), (2.0, 0.7, 3)]
+)
 def test_march_ends_exactly_at_t_end(t_end, dt, n):
     """t_end/dt not an integer: the last step is shortened and the run ends exactly at t_end.
     (0.3/0.1 = 2.9999999999999996 in floating point: still 3 steps.)"""
@@ -368,16 +402,19 @@ def test_march_property(t_end, frac):
     assert len(ts) - 1 in (math.floor(t_end / dt + 1e-9), math.ceil(t_end / dt - 1e-9))
 
 
-@pytest.mark.parametrize("t_end, dt, msg", [
-    (1.0, 0.0, r"dt must be > 0.*positive time step"),
-    (1.0, -0.1, r"dt must be > 0"),
-    (0.0, 0.1, r"t_end must be > 0"),
-    (-1.0, 0.1, r"t_end must be > 0"),
-    (math.nan, 0.1, r"t_end must be finite"),
-    (1.0, math.inf, r"dt must be finite"),
-    (0.1, 0.2, r"larger than t_end.*use dt <= t_end"),
-    (1e3, 1e-5, r"too many: increase dt"),
-])
+@pytest.mark.parametrize(
+    "t_end, dt, msg",
+    [
+        (1.0, 0.0, r"dt must be > 0.*positive time step"),
+        (1.0, -0.1, r"dt must be > 0"),
+        (0.0, 0.1, r"t_end must be > 0"),
+        (-1.0, 0.1, r"t_end must be > 0"),
+        (math.nan, 0.1, r"t_end must be finite"),
+        (1.0, math.inf, r"dt must be finite"),
+        (0.1, 0.2, r"larger than t_end.*use dt <= t_end"),
+        (1e3, 1e-5, r"too many: increase dt"),
+    ],
+)
 def test_check_run_invalid(t_end, dt, msg):
     with pytest.raises(SceneError, match=msg):
         check_run(t_end, dt)
@@ -402,9 +439,12 @@ def test_film_rupture_rigid_substrate():
     is exactly d = hc(t) = 0.5 - t.  With dt = 0.15 the first non-positive film is at
     t = 0.6 (d = -0.1) at the tip (0, 0); the states before are valid (finite, positive,
     film_center = hc because w = 0)."""
-    sc = Scene(substrate=Rigid(), fluid=Fluid(1.0),
-               motion=Motion(gap=RampHold(h0=0.5, h_end=-0.5, t1=1.0), velocity=0.0),
-               domain=Domain(2.0))
+    sc = Scene(
+        substrate=Rigid(),
+        fluid=Fluid(1.0),
+        motion=Motion(gap=RampHold(h0=0.5, h_end=-0.5, t1=1.0), velocity=0.0),
+        domain=Domain(2.0),
+    )
     got = []
     with pytest.raises(FilmRuptureError, match=r"film thickness reached.*smaller dt") as exc:
         for s in api.steps(sc, 1.0, 0.15, "fd", dr=0.1, dtheta=math.pi / 4):
@@ -421,4 +461,4 @@ def test_film_rupture_rigid_substrate():
         assert s.film_min > 0 and s.film_center == pytest.approx(0.5 - s.t, abs=1e-12)
         assert s.film_min == pytest.approx(s.film_center, abs=1e-12)
         if s.step > 0:
-            assert s.load > 0          # squeeze pressure under a closing gap
+            assert s.load > 0  # squeeze pressure under a closing gap

@@ -1,4 +1,4 @@
-"""Scenes beyond the paper (issue 5): indenter shapes, substrates, imposed load, SI, files.
+"""Scenes beyond the paper: indenter shapes, substrates, imposed load, SI, files.
 
 Physics checks here:
 
@@ -12,6 +12,7 @@ Physics checks here:
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import re
 
@@ -26,12 +27,23 @@ from femehl.cli import main as cli_main
 from femehl.errors import SceneError, SceneFileError
 from femehl.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape, Sphere, si_indenter
 from femehl.run import run_to_folder
-from femehl.scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
-                          Scene, Table, Winkler)
+from femehl.scene import (
+    Constant,
+    Dimensional,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Table,
+    Winkler,
+)
 from femehl.scenefile import SUBSTRATES, load_scene_file
 from femehl.stepping import march
 
-HERTZ_LOAD = 4.0 / (3.0 * math.pi)       # normalized Hertz load at hc = -1 (design.md s. 2)
+HERTZ_LOAD = 4.0 / (3.0 * math.pi)  # normalized Hertz load at hc = -1 (docs/design.md, section 2)
 
 
 def ripple(x, y):
@@ -76,7 +88,7 @@ def test_indenter_contract(name):
     assert float(ind.gap(0.0, 0.0)) == pytest.approx(0.0, abs=1e-14)
     assert isinstance(ind.symmetric_y, bool) and isinstance(ind.axisymmetric, bool)
     mirrored = np.allclose(ind.gap(x, -y), s, rtol=0, atol=1e-12)
-    assert mirrored == ind.symmetric_y          # (the example Shape is not symmetric)
+    assert mirrored == ind.symmetric_y  # (the example Shape is not symmetric)
     if ind.axisymmetric:
         th = rng.uniform(0, 2 * math.pi, 5)
         r = np.hypot(x[0], y[0])
@@ -88,7 +100,9 @@ def test_ellipsoid_shape_and_flags():
     assert e.gap(1.0, 0.0) == pytest.approx(1.0) and e.gap(0.0, 1.0) == pytest.approx(0.25)
     assert e.symmetric_y and not e.axisymmetric
     assert Ellipsoid(1.5, 1.5).axisymmetric
-    assert np.allclose(Ellipsoid(1.0, 1.0).gap([0.3, 1.1], [0.7, -0.2]), Sphere().gap([0.3, 1.1], [0.7, -0.2]))
+    assert np.allclose(
+        Ellipsoid(1.0, 1.0).gap([0.3, 1.1], [0.7, -0.2]), Sphere().gap([0.3, 1.1], [0.7, -0.2])
+    )
 
 
 def test_flat_punch_is_flat_then_c1_rounded():
@@ -98,19 +112,19 @@ def test_flat_punch_is_flat_then_c1_rounded():
     assert np.all(s[r <= 0.6] == 0.0)
     assert np.allclose(s[r > 0.6], (r[r > 0.6] - 0.6) ** 2 / 0.6)
     slope = np.diff(s) / np.diff(r)
-    assert np.max(np.abs(np.diff(slope))) < 2.0 * (r[1] - r[0]) / 0.3     # no kink: C1
+    assert np.max(np.abs(np.diff(slope))) < 2.0 * (r[1] - r[0]) / 0.3  # no kink: C1
 
 
 def test_heightmap_is_bilinear_and_detects_symmetry():
     x = np.linspace(-2.0, 2.0, 9)
     y = np.linspace(-2.5, 2.5, 11)
-    f = lambda x, y: 0.3 + 0.2 * x - 0.1 * y + 0.05 * x * y                   # noqa: E731
+    f = lambda x, y: 0.3 + 0.2 * x - 0.1 * y + 0.05 * x * y  # noqa: E731
     hm = HeightMap(x, y, f(x[:, None], y[None, :]))
     pts = np.random.default_rng(2).uniform(-2.0, 2.0, (2, 50))
-    assert np.allclose(hm.gap(*pts), f(*pts), rtol=0, atol=1e-13)          # bilinear is exact
+    assert np.allclose(hm.gap(*pts), f(*pts), rtol=0, atol=1e-13)  # bilinear is exact
     assert not hm.symmetric_y
     assert sphere_map().symmetric_y
-    assert not HeightMap(x, y + 0.1, np.zeros((9, 11))).symmetric_y        # y grid not symmetric
+    assert not HeightMap(x, y + 0.1, np.zeros((9, 11))).symmetric_y  # y grid not symmetric
     assert HeightMap(x, y, np.zeros((9, 11)), symmetric_y=False).symmetric_y is False
     assert hm.extent == 2.0
     # the grid's own boundary is inside (mesh nodes are snapped onto r = L)
@@ -121,7 +135,7 @@ def test_heightmap_from_file(tmp_path):
     g = np.linspace(-2.5, 2.5, 21)
     np.savez(tmp_path / "m.npz", x=g, y=g, z=0.5 * (g[:, None] ** 2 + g[None, :] ** 2))
     hm = HeightMap.from_file(tmp_path / "m.npz")
-    assert hm.symmetric_y and hm.gap(0.25, 0.0) == pytest.approx(0.5 * 0.25 ** 2, abs=0.01)
+    assert hm.symmetric_y and hm.gap(0.25, 0.0) == pytest.approx(0.5 * 0.25**2, abs=0.01)
     np.savez(tmp_path / "bad.npz", x=g, z=g)
     with pytest.raises(SceneError, match=r"lacks arrays \['y'\].*np.savez"):
         HeightMap.from_file(tmp_path / "bad.npz")
@@ -134,24 +148,27 @@ def test_shape_wraps_a_function():
     assert not sh.symmetric_y and not sh.axisymmetric
     x = np.array([[0.1, -0.4], [1.0, 0.3]])
     assert np.array_equal(sh.gap(x, x.T), ripple(x, x.T))
-    assert Shape(lambda x, y: 0.0).gap(np.ones(3), np.ones(3)).shape == (3,)   # scalar broadcast
+    assert Shape(lambda x, y: 0.0).gap(np.ones(3), np.ones(3)).shape == (3,)  # scalar broadcast
 
 
-@pytest.mark.parametrize("make,match", [
-    (lambda: Ellipsoid(-1.0, 1.0), r"Rx must be > 0.*positive radii"),
-    (lambda: Ellipsoid(1.0, 0.0), r"Ry must be > 0"),
-    (lambda: FlatPunch(0.5, 0.0), r"edge_radius must be > 0.*rounded edge"),
-    (lambda: FlatPunch(0.5, -0.1), r"edge_radius must be > 0"),
-    (lambda: FlatPunch(0.0, 0.5), r"radius a must be > 0.*Sphere"),
-    (lambda: Shape(lambda x, y: np.full_like(x, np.nan)), r"not finite.*fix the function"),
-    (lambda: Shape(lambda x, y: x[:1]), r"returned shape.*one value per point"),
-    (lambda: Shape(lambda x, y: math.sin(x)), r"raised TypeError.*numpy arrays"),
-    (lambda: Shape("x**2"), r"must be a callable"),
-    (lambda: HeightMap([0, 2, 1], [0, 1], np.zeros((3, 2))), r"strictly increasing.*sort"),
-    (lambda: HeightMap([0, 1], [0, 1], [[0, np.nan], [0, 0]]), r"NaN.*fill the gaps"),
-    (lambda: HeightMap([0, 1, 2], [0, 1], np.zeros((2, 3))), r"shape \(2, 3\).*transpose"),
-    (lambda: HeightMap([0.0], [0, 1], np.zeros((1, 2))), r"at least 2"),
-])
+@pytest.mark.parametrize(
+    "make,match",
+    [
+        (lambda: Ellipsoid(-1.0, 1.0), r"Rx must be > 0.*positive radii"),
+        (lambda: Ellipsoid(1.0, 0.0), r"Ry must be > 0"),
+        (lambda: FlatPunch(0.5, 0.0), r"edge_radius must be > 0.*rounded edge"),
+        (lambda: FlatPunch(0.5, -0.1), r"edge_radius must be > 0"),
+        (lambda: FlatPunch(0.0, 0.5), r"radius a must be > 0.*Sphere"),
+        (lambda: Shape(lambda x, y: np.full_like(x, np.nan)), r"not finite.*fix the function"),
+        (lambda: Shape(lambda x, y: x[:1]), r"returned shape.*one value per point"),
+        (lambda: Shape(lambda x, y: math.sin(x)), r"raised TypeError.*numpy arrays"),
+        (lambda: Shape("x**2"), r"must be a callable"),
+        (lambda: HeightMap([0, 2, 1], [0, 1], np.zeros((3, 2))), r"strictly increasing.*sort"),
+        (lambda: HeightMap([0, 1], [0, 1], [[0, np.nan], [0, 0]]), r"NaN.*fill the gaps"),
+        (lambda: HeightMap([0, 1, 2], [0, 1], np.zeros((2, 3))), r"shape \(2, 3\).*transpose"),
+        (lambda: HeightMap([0.0], [0, 1], np.zeros((1, 2))), r"at least 2"),
+    ],
+)
 def test_bad_indenters_raise_clear_errors(make, match):
     with pytest.raises(SceneError, match=match):
         make()
@@ -172,8 +189,7 @@ def test_domain_check_is_the_old_rule_for_a_sphere():
         a = math.sqrt(R * -hc)
         Scene(indenter=Sphere(R), motion=Motion(gap=RampHold(0.1, hc, 1.0)), domain=Domain(1.5 * a))
         with pytest.raises(SceneError, match=r"too small to hold the contact.*Use L >= "):
-            Scene(indenter=Sphere(R), motion=Motion(gap=RampHold(0.1, hc, 1.0)),
-                  domain=Domain(1.49 * a))
+            Scene(indenter=Sphere(R), motion=Motion(gap=RampHold(0.1, hc, 1.0)), domain=Domain(1.49 * a))
 
 
 def test_domain_check_under_imposed_load():
@@ -181,7 +197,7 @@ def test_domain_check_under_imposed_load():
     Scene(motion=Motion(gap=0.1, load=HERTZ_LOAD), domain=Domain(1.5))
     with pytest.raises(SceneError, match=r"imposed load.*too small|too small.*imposed load"):
         Scene(motion=Motion(gap=0.1, load=HERTZ_LOAD), domain=Domain(1.49))
-    table = Table((0.0, 5.0, 20.0), (0.0, 8 * HERTZ_LOAD, 8 * HERTZ_LOAD))    # max reached at t=5
+    table = Table((0.0, 5.0, 20.0), (0.0, 8 * HERTZ_LOAD, 8 * HERTZ_LOAD))  # max reached at t=5
     Scene(motion=Motion(gap=0.1, load=table), domain=Domain(3.01))
     with pytest.raises(SceneError, match=r"Use L >= 3\b"):
         Scene(motion=Motion(gap=0.1, load=table), domain=Domain(2.9))
@@ -200,10 +216,14 @@ def test_domain_check_for_other_shapes():
     # flat punch: a_geo = a + sqrt(2 e |hc|)
     a_geo = 1.0 + math.sqrt(2 * 0.5 * 1.0)
     with pytest.raises(SceneError, match="too small"):
-        Scene(indenter=FlatPunch(1.0, 0.5), motion=Motion(gap=RampHold(0.1, -1.0, 1.0)),
-              domain=Domain(1.05 * a_geo))
-    Scene(indenter=FlatPunch(1.0, 0.5), motion=Motion(gap=RampHold(0.1, -1.0, 1.0)),
-          domain=Domain(1.07 * a_geo))
+        Scene(
+            indenter=FlatPunch(1.0, 0.5),
+            motion=Motion(gap=RampHold(0.1, -1.0, 1.0)),
+            domain=Domain(1.05 * a_geo),
+        )
+    Scene(
+        indenter=FlatPunch(1.0, 0.5), motion=Motion(gap=RampHold(0.1, -1.0, 1.0)), domain=Domain(1.07 * a_geo)
+    )
     # a user function that is not finite on the domain
     with pytest.raises(SceneError, match=r"not finite.*fix the function"):
         Scene(indenter=Shape(lambda x, y: np.where(np.hypot(x, y) > 1.5, np.nan, x * x)))
@@ -260,9 +280,9 @@ def test_combination_runs(indenter, substrate, control, sliding):
     if control == "load":
         target = np.array([min(s.t / 0.1, 1.0) * F for s in states[1:]])
         assert np.max(np.abs(loads - target)) <= 1e-9 * F
-        assert all(b.hc < a.hc for a, b in zip(states, states[1:]))      # it sinks
+        assert all(b.hc < a.hc for a, b in itertools.pairwise(states))  # it sinks
     elif not sliding:
-        assert np.all(loads > 0.0)                                          # squeeze film
+        assert np.all(loads > 0.0)  # squeeze film
     if not sliding:
         assert np.all(np.array([s.p.min() for s in states]) > -1e-12 * max(s.p_max for s in states))
 
@@ -281,21 +301,29 @@ def squeeze_G(hc, L):
       = -(dhc/dt) (pi/(2 beta)) [1/hc - 1/u_L - (u_L - hc)/u_L^2].
     """
     uL = hc + 0.5 * L * L
-    return 1.0 / hc - 1.0 / uL - (uL - hc) / uL ** 2
+    return 1.0 / hc - 1.0 / uL - (uL - hc) / uL**2
 
 
 def squeeze_reference(F, beta, h0, L, ts):
-    sol = solve_ivp(lambda t, h: [-F * (2.0 * beta / math.pi) / squeeze_G(h[0], L)], (0.0, ts[-1]),
-                    [h0], t_eval=ts, rtol=1e-12, atol=1e-14, method="LSODA")
+    sol = solve_ivp(
+        lambda t, h: [-F * (2.0 * beta / math.pi) / squeeze_G(h[0], L)],
+        (0.0, ts[-1]),
+        [h0],
+        t_eval=ts,
+        rtol=1e-12,
+        atol=1e-14,
+        method="LSODA",
+    )
     return sol.y[0]
 
 
 def test_squeeze_G_matches_quadrature():
     """G(hc) against a direct quadrature of the pressure of the derivation above."""
     from scipy.integrate import quad
+
     hc, L, beta, hdot = 0.3, 2.0, 1.7, -0.9
     uL = hc + L * L / 2
-    p = lambda r: -(hdot / (4 * beta)) * (1 / (hc + r * r / 2) ** 2 - 1 / uL ** 2)     # noqa: E731
+    p = lambda r: -(hdot / (4 * beta)) * (1 / (hc + r * r / 2) ** 2 - 1 / uL**2)  # noqa: E731
     F = quad(lambda r: 2 * math.pi * r * p(r), 0, L, epsabs=1e-13, epsrel=1e-13)[0]
     assert F == pytest.approx(-hdot * math.pi / (2 * beta) * squeeze_G(hc, L), rel=1e-10)
 
@@ -318,7 +346,7 @@ def test_rigid_sphere_follows_the_squeeze_law():
         errs.append(float(np.max(np.abs(r.hc - ref) / ref)))
         assert np.max(np.abs(r.load[1:] - F)) <= 1e-9 * F
     assert errs[0] < 1.2e-2 and errs[1] < 6e-3, errs
-    assert errs[1] < 0.65 * errs[0], errs                  # the error decreases with the mesh
+    assert errs[1] < 0.65 * errs[0], errs  # the error decreases with the mesh
 
 
 def test_fd_imposed_load_follows_the_squeeze_law():
@@ -330,13 +358,17 @@ def test_fd_imposed_load_follows_the_squeeze_law():
         r = femehl.solve(sc, "fd", dr=dr, dtheta=math.pi / n, t_end=1.0, dt=0.02, store_every=0)
         assert np.max(np.abs(r.load[1:] - F)) <= 1e-9 * F
         errs.append(float(np.max(np.abs(r.hc - squeeze_reference(F, beta, h0, L, r.t)) / r.hc)))
-    assert errs[1] < 0.7 * errs[0] and errs[1] < 0.04, errs       # measured 4.9e-2, 2.7e-2
+    assert errs[1] < 0.7 * errs[0] and errs[1] < 0.04, errs  # measured 4.9e-2, 2.7e-2
 
 
 def hertz_run(F, nu=0.5, t_end=3.0):
     """Elastic sphere, beta = 200, load ramped from 0 to F over t in [0, 0.5], then held."""
-    sc = Scene(substrate=HalfSpace(nu), fluid=Fluid(200.0),
-               motion=Motion(gap=0.1, load=Table((0.0, 0.5), (0.0, F))), domain=Domain(2.0))
+    sc = Scene(
+        substrate=HalfSpace(nu),
+        fluid=Fluid(200.0),
+        motion=Motion(gap=0.1, load=Table((0.0, 0.5), (0.0, F))),
+        domain=Domain(2.0),
+    )
     return femehl.solve(sc, "fe", mesh="coarse", t_end=t_end, dt=0.05, store_every=0)
 
 
@@ -353,16 +385,16 @@ def test_elastic_sphere_approaches_hertz(scale):
     and -0.637 (0.8 %, 1.1 %: the trapped film makes the pressure slightly non-Hertzian).
     """
     F = scale * HERTZ_LOAD
-    hc_H = -scale ** (2.0 / 3.0)
+    hc_H = -(scale ** (2.0 / 3.0))
     r = hertz_run(F)
     hold = r.t >= 0.5
     assert np.max(np.abs(r.load[hold] - F)) <= 1e-9 * F
     hc = r.hc[hold]
-    assert np.all(np.diff(hc) < 0.0)                      # keeps sinking
-    assert np.all(hc > hc_H)                              # from above
+    assert np.all(np.diff(hc) < 0.0)  # keeps sinking
+    assert np.all(hc > hc_H)  # from above
     assert 0.0 < hc[-1] - hc_H < 0.06 * abs(hc_H)
-    assert np.all(np.diff(r.film_center[hold]) < 0.0)     # the film keeps draining
-    dry = r.hc[-1] - r.film_center[-1]                    # elastic depth under the tip
+    assert np.all(np.diff(r.film_center[hold]) < 0.0)  # the film keeps draining
+    dry = r.hc[-1] - r.film_center[-1]  # elastic depth under the tip
     assert abs(dry - hc_H) < 0.02 * abs(hc_H)
 
 
@@ -381,33 +413,40 @@ def test_compressible_halfspace_deflection_scaling():
     # small deflection: the squeeze pressure hardly depends on the substrate
     w0 = []
     for nu in (0.5, 0.3):
-        sc = Scene(substrate=HalfSpace(nu), fluid=Fluid(2000.0),
-                   motion=Motion(gap=RampHold(0.3, 0.1, 1.0)), domain=Domain(2.0))
+        sc = Scene(
+            substrate=HalfSpace(nu),
+            fluid=Fluid(2000.0),
+            motion=Motion(gap=RampHold(0.3, 0.1, 1.0)),
+            domain=Domain(2.0),
+        )
         s = femehl.solve(sc, "fe", mesh="coarse", t_end=0.2, dt=0.05).states[-1]
-        w0.append(s.hc - s.film_center)                   # w(0, 0) (s(0, 0) = 0)
+        w0.append(s.hc - s.film_center)  # w(0, 0) (s(0, 0) = 0)
     ratio = w0[1] / w0[0]
-    rel_w = abs(w0[0]) / 0.26                             # deflection / film at the tip
+    rel_w = abs(w0[0]) / 0.26  # deflection / film at the tip
     assert 1.4 * (1 - 3 * rel_w) < ratio <= 1.4, (ratio, rel_w)
 
 
 # ---------------------------------------------------------------------------
 # the terms a run assembles, as logged at its start
 # ---------------------------------------------------------------------------
-@pytest.mark.parametrize("sub,V,load", [(Rigid(), 0.0, None), (Winkler(2.0), 0.5, None),
-                                        (HalfSpace(), 0.0, 0.05)])
+@pytest.mark.parametrize(
+    "sub,V,load", [(Rigid(), 0.0, None), (Winkler(2.0), 0.5, None), (HalfSpace(), 0.0, 0.05)]
+)
 def test_logged_terms_agree_with_the_stepper(tmp_path, sub, V, load):
     lines = []
-    sc = Scene(substrate=sub, fluid=Fluid(10.0),
-               motion=Motion(gap=RampHold(0.3, 0.1, 1.0), velocity=V, load=load))
-    res = run_to_folder(sc, tmp_path, method="fe", mesh="coarse", t_end=0.1, dt=0.05,
-                        store_every=0, log=lines.append)
+    sc = Scene(
+        substrate=sub, fluid=Fluid(10.0), motion=Motion(gap=RampHold(0.3, 0.1, 1.0), velocity=V, load=load)
+    )
+    res = run_to_folder(
+        sc, tmp_path, method="fe", mesh="coarse", t_end=0.1, dt=0.05, store_every=0, log=lines.append
+    )
     m = re.search(r"terms: squeeze=(\w+), sliding=(\w+), elasticity=(\w+), imposed_load=(\w+)", lines[0])
     assert m, lines[0]
     squeeze, sliding, elasticity, imposed = m.groups()
     assert squeeze == "True"
     assert sliding == str(res.info["couette_assembled"]) == str(V != 0.0)
     assert elasticity == sub.kind
-    assert (res.info["operator_bytes"] > 1e6) is (elasticity == "halfspace")   # dense only then
+    assert (res.info["operator_bytes"] > 1e6) is (elasticity == "halfspace")  # dense only then
     assert imposed == str(load is not None)
 
 
@@ -427,37 +466,63 @@ def test_scene_file_new_indenters_and_load(tmp_path):
         '[indenter]\nkind = "ellipsoid"\nRx = 0.5\nRy = 2.0\n': Ellipsoid(0.5, 2.0),
         '[indenter]\nkind = "flat_punch"\na = 0.5\nedge_radius = 0.3\n': FlatPunch(0.5, 0.3),
     }
-    motion = '[motion.gap]\nkind = "constant"\nvalue = 0.2\n[motion.load]\nkind = "table"\n' \
-             'times = [0.0, 1.0]\nvalues = [0.0, 0.3]\n'
+    motion = (
+        '[motion.gap]\nkind = "constant"\nvalue = 0.2\n[motion.load]\nkind = "table"\n'
+        "times = [0.0, 1.0]\nvalues = [0.0, 0.3]\n"
+    )
     for text, want in cases.items():
         sc, run = load_scene_file(_write(tmp_path, text + motion))
         assert sc.indenter == want and sc.motion.load_controlled and sc.motion.F(0.5) == 0.15
         assert sc.motion.hc(0.0) == 0.2 and run == {}
-    sc, _ = load_scene_file(_write(tmp_path, '[indenter]\nkind = "heightmap"\nfile = "map.npz"\n'
-                                   '[motion]\nload = 0.1\n[motion.gap]\nkind = "constant"\nvalue = 0.2\n'))
+    sc, _ = load_scene_file(
+        _write(
+            tmp_path,
+            '[indenter]\nkind = "heightmap"\nfile = "map.npz"\n'
+            '[motion]\nload = 0.1\n[motion.gap]\nkind = "constant"\nvalue = 0.2\n',
+        )
+    )
     assert isinstance(sc.indenter, HeightMap) and sc.indenter.symmetric_y and sc.motion.F(3.0) == 0.1
-    sc, _ = load_scene_file(_write(tmp_path, '[indenter]\nkind = "heightmap"\nx = [-2.0, 2.0]\n'
-                                   'y = [-2.0, 2.0]\nz = [[4.0, 4.0], [4.0, 4.0]]\n'
-                                   '[motion.gap]\nkind = "constant"\nvalue = 0.2\n'))
+    sc, _ = load_scene_file(
+        _write(
+            tmp_path,
+            '[indenter]\nkind = "heightmap"\nx = [-2.0, 2.0]\n'
+            "y = [-2.0, 2.0]\nz = [[4.0, 4.0], [4.0, 4.0]]\n"
+            '[motion.gap]\nkind = "constant"\nvalue = 0.2\n',
+        )
+    )
     assert sc.indenter.gap(0.0, 0.0) == 4.0
 
 
-@pytest.mark.parametrize("text,match", [
-    ('[indenter]\nkind = "cone"\n', r"\[indenter\] kind = 'cone' is not known; use one of"),
-    ('[indenter]\nkind = "ellipsoid"\nRx = -1.0\nRy = 1.0\n', r"\[indenter\].*Rx must be > 0"),
-    ('[indenter]\nkind = "flat_punch"\na = 0.5\nedge_radius = 0.0\n', r"edge_radius must be > 0"),
-    ('[indenter]\nkind = "shape"\nfunc = "x**2"\n', r"must be a callable.*heightmap"),
-    ('[indenter]\nkind = "heightmap"\nfile = "nope.npz"\n', r"\[indenter\].*does not exist"),
-    ('[indenter]\nkind = "heightmap"\nfile = "small.npz"\n', r"does not cover the domain.*extend the map"),
-    ('[motion.load]\nkind = "table"\ntimes = [0.0, 1.0]\nvalues = [0.0, nan]\n',
-     r"\[motion.load\].*finite \(no NaN"),
-    ('[motion]\nload = nan\n', r"\[motion.load\].*finite"),
-    ('[motion]\nforce = 1.0\n', r"\[motion\] takes gap, velocity and load"),
-    ('[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n'
-     '[indenter]\nkind = "heightmap"\n', r"cannot be given in SI units"),
-    ('[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n'
-     '[indenter]\nkind = "ellipsoid"\nRx = 0.01\nRy = -0.02\n', r"\[si\].*Ry \[m\] must be > 0"),
-])
+@pytest.mark.parametrize(
+    "text,match",
+    [
+        ('[indenter]\nkind = "cone"\n', r"\[indenter\] kind = 'cone' is not known; use one of"),
+        ('[indenter]\nkind = "ellipsoid"\nRx = -1.0\nRy = 1.0\n', r"\[indenter\].*Rx must be > 0"),
+        ('[indenter]\nkind = "flat_punch"\na = 0.5\nedge_radius = 0.0\n', r"edge_radius must be > 0"),
+        ('[indenter]\nkind = "shape"\nfunc = "x**2"\n', r"must be a callable.*heightmap"),
+        ('[indenter]\nkind = "heightmap"\nfile = "nope.npz"\n', r"\[indenter\].*does not exist"),
+        (
+            '[indenter]\nkind = "heightmap"\nfile = "small.npz"\n',
+            r"does not cover the domain.*extend the map",
+        ),
+        (
+            '[motion.load]\nkind = "table"\ntimes = [0.0, 1.0]\nvalues = [0.0, nan]\n',
+            r"\[motion.load\].*finite \(no NaN",
+        ),
+        ("[motion]\nload = nan\n", r"\[motion.load\].*finite"),
+        ("[motion]\nforce = 1.0\n", r"\[motion\] takes gap, velocity and load"),
+        (
+            "[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n"
+            '[indenter]\nkind = "heightmap"\n',
+            r"cannot be given in SI units",
+        ),
+        (
+            "[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n"
+            '[indenter]\nkind = "ellipsoid"\nRx = 0.01\nRy = -0.02\n',
+            r"\[si\].*Ry \[m\] must be > 0",
+        ),
+    ],
+)
 def test_bad_scene_files(tmp_path, text, match):
     g = np.linspace(-1.0, 1.0, 5)
     np.savez(tmp_path / "small.npz", x=g, y=g, z=0.5 * (g[:, None] ** 2 + g[None, :] ** 2))
@@ -478,7 +543,7 @@ def test_si_indenter_conversion():
     assert fp.a == pytest.approx(0.5) and fp.edge_radius == pytest.approx(0.3)
     # the normalized gap of a sphere of radius R is r^2/2 in units of h_inf
     sphere = si_indenter("sphere", {"R": 0.01}, DIM)
-    x = 1e-3                                                 # m
+    x = 1e-3  # m
     assert sphere.gap(x / DIM.length, 0.0) * DIM.h_inf == pytest.approx(x * x / (2 * 0.01))
 
 
@@ -486,31 +551,57 @@ def test_result_table_in_si():
     sc = DIM.scene(h0=1e-5)
     res = femehl.solve(sc, "fe", mesh="coarse", t_end=0.2, dt=0.1, store_every=0)
     tab = DIM.result_table(res)
-    assert set(tab) == {"t", "hc", "load", "film_center", "film_min", "film_min_x", "film_min_y",
-                        "p_max", "p_max_x", "p_max_y"}
+    assert set(tab) == {
+        "t",
+        "hc",
+        "load",
+        "film_center",
+        "film_min",
+        "film_min_x",
+        "film_min_y",
+        "p_max",
+        "p_max_x",
+        "p_max_y",
+    }
     assert np.allclose(tab["t"], res.t * DIM.time)
     assert np.allclose(tab["hc"], res.hc * 1e-4) and tab["hc"][0] == pytest.approx(1e-5)
-    assert np.allclose(tab["load"], res.load * DIM.pressure * DIM.length ** 2)
+    assert np.allclose(tab["load"], res.load * DIM.pressure * DIM.length**2)
     assert np.allclose(tab["p_max"], res.p_max * 4 * math.pi * 1e5 * math.sqrt(1e-4 / 0.01))
     assert DIM.RESULT_COLUMNS["load"][2] == "N"
 
 
 def test_cli_writes_si_summary(tmp_path, capsys):
-    scene = _write(tmp_path, '[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\n'
-                   'h0 = 1e-5\nload = 0.01\n[indenter]\nkind = "ellipsoid"\nRx = 0.005\nRy = 0.02\n')
+    scene = _write(
+        tmp_path,
+        "[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\n"
+        'h0 = 1e-5\nload = 0.01\n[indenter]\nkind = "ellipsoid"\nRx = 0.005\nRy = 0.02\n',
+    )
     sc, run = load_scene_file(scene)
     assert isinstance(run["_dimensional"], Dimensional)
     assert sc.indenter == Ellipsoid(0.5, 2.0)
     F = 0.01 / DIM.force
     assert sc.motion.load_controlled and sc.motion.F(1.0) == pytest.approx(F)
     out = tmp_path / "out"
-    rc = cli_main(["run", str(scene), "--mesh", "coarse", "--t-end", "0.1", "--dt", "0.05",
-                   "--out", str(out), "--quiet"])
+    rc = cli_main(
+        [
+            "run",
+            str(scene),
+            "--mesh",
+            "coarse",
+            "--t-end",
+            "0.1",
+            "--dt",
+            "0.05",
+            "--out",
+            str(out),
+            "--quiet",
+        ]
+    )
     assert rc == 0
     assert "imposed_load=True" in capsys.readouterr().out
     with open(out / "summary_si.csv") as fh:
         rows = list(csv.reader(fh))
     assert rows[0][:4] == ["t_s", "hc_m", "load_N", "film_center_m"]
     data = np.array(rows[1:], dtype=float)
-    assert data[-1, 2] == pytest.approx(0.01, rel=1e-9)            # the imposed load, in N
+    assert data[-1, 2] == pytest.approx(0.01, rel=1e-9)  # the imposed load, in N
     assert data[0, 1] == pytest.approx(1e-5)

@@ -1,4 +1,4 @@
-"""Stress corners, the relaxation baseline, failure handling and resume (issue 7).
+"""Stress corners, the relaxation baseline, failure handling and resume.
 
 The full stress matrix is ``femehl bench stress`` (benchmarks/stress.py, results in
 benchmarks/stress_results.md); here a reduced form runs its corners on the coarse mesh.
@@ -7,17 +7,20 @@ Corners (coarse mesh, T = 0.1, dt = 0.05, t_end = 3):
 
 * beta = 2 (viscous / fast: thick films, large squeeze term) with h0 = 0.01 and 1: stable.
 * beta = 20000 (inviscid / slow: films of order 1e-3 at the contact edge) with h0 = 0.01
-  and 1: the coarse mesh and this dt cannot follow the film, which goes negative at one
-  element; the run stops with the documented FilmRuptureError naming time and place.
-  This is resolution, not physics: lubrication films do not reach zero in finite time,
-  and the benchmark shows beta = 20000 at dt = 0.01 surviving on finer meshes (see
-  benchmarks/stress_results.md).  The test pins the documented failure mode.
+  and 1: today the coarse mesh and this dt cannot follow the film, which goes negative at
+  one element (at t = 0.05 and 0.55), and the run stops with the documented
+  FilmRuptureError naming time and place.  This is resolution, not physics: lubrication
+  films do not reach zero in finite time, and the benchmark shows beta = 20000 at
+  dt = 0.01 surviving on finer meshes (see benchmarks/stress_results.md).  The test
+  accepts either outcome a correct solver may give -- completion with positive, finite
+  films, or the documented failure mode -- and not a particular rupture time.
 """
 
 from __future__ import annotations
 
 import csv
 import importlib.util
+import itertools
 import math
 import pathlib
 import xml.etree.ElementTree as ET
@@ -61,33 +64,39 @@ def test_soft_viscous_corner_is_stable(h0):
     assert not row["nonfinite"]
     assert row["sawtooth"] < stress.SAWTOOTH_LIMIT
     assert row["stable"]
-    assert 0.0 < row["film_min"] <= h0 + 0.01        # h0 + s at the nearest centroid
+    assert 0.0 < row["film_min"] <= h0 + 0.01  # h0 + s at the nearest centroid
     # each step solves its weak form: the solver stops at ||b - A p|| <= 1e-8 ||b|| (default
-    # rtol); this residual is scaled by the squeeze/Couette terms instead (measured <= ~10 rtol)
-    assert row["mass_residual_max"] < 100 * 1e-8
+    # rtol); this residual is scaled by the squeeze/Couette terms instead: measured 7.2 rtol
+    # (h0 = 0.01) and 8.4 rtol (h0 = 1); bound about 2x
+    assert row["mass_residual_max"] < 17 * 1e-8
 
 
-@pytest.mark.parametrize("h0, t_stop", [(0.01, 0.05), (1.0, 0.55)])
-def test_thin_film_corner_stops_with_documented_rupture(h0, t_stop):
+@pytest.mark.parametrize("h0", [0.01, 1.0])
+def test_thin_film_corner_completes_or_stops_with_documented_rupture(h0):
     stepper = femehl.make_stepper(stress.paper_scene(20000.0, h0, 0.1), "fe", mesh="coarse")
     reached = []
-    with pytest.raises(FilmRuptureError) as info:
+    try:
         for s in march(stepper, 3.0, 0.05):
             reached.append(s)
-    exc = info.value
-    assert exc.t == pytest.approx(t_stop, abs=0.051)
-    assert exc.d_min <= 0.0
-    x, y = exc.where
-    assert math.hypot(x, y) < 2.0
-    msg = str(exc)
-    for part in (f"t = {exc.t:.6g}", "(x, y)", "ruptured", "solid contact", "smaller dt", "finer mesh"):
-        assert part in msg
+    except FilmRuptureError as exc:
+        # the documented failure mode: when, where, how thin, and what to try
+        assert 0.0 < exc.t <= 3.0 + 1e-9
+        assert exc.d_min <= 0.0
+        x, y = exc.where
+        assert math.hypot(x, y) < 2.0
+        msg = str(exc)
+        for part in (f"t = {exc.t:.6g}", "(x, y)", "ruptured", "solid contact", "smaller dt", "finer mesh"):
+            assert part in msg
+        assert not reached or reached[-1].t < exc.t
+    else:
+        assert reached[-1].t == pytest.approx(3.0)
+    # every state handed out before a stop (or all of them) is physical
     assert all(s.film_min > 0 and np.all(np.isfinite(s.p)) for s in reached)
-    assert reached[-1].t < exc.t
 
 
 def test_oscillation_measures():
     """A period-2dt sawtooth is flagged; a smooth decay and a min hopping between elements are not."""
+
     def track(seq, t_start=0.0):
         o = stress.OscillationTracker(t_start)
         for k, d in enumerate(seq):
@@ -118,7 +127,7 @@ def test_relaxation_baseline_converges_then_diverges():
             states.append(s)
     # the first steps converge (to tol 1e-6 on the pressure change) ...
     assert len(states) >= 3
-    for a, b in zip(states, states[1:]):
+    for a, b in itertools.pairwise(states):
         assert 1 <= b.info["iterations"] <= 200
         assert mass_balance_residual(st, a, b, "implicit") < 1e-4
     # ... then the film thins and the fixed point diverges (the paper's section 1)
@@ -149,16 +158,21 @@ def test_femehl_step_solves_its_weak_form():
     for s in march(st, 1.3, 0.1):
         if prev is not None:
             # the solver stops at ||b - A p|| <= rtol ||b||; this residual is scaled by the
-            # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound 100 rtol)
-            assert mass_balance_residual(st, prev, s) < 100 * st.solver.rtol
+            # squeeze/Couette terms instead of ||b|| (measured up to 7.7 rtol here; bound about 2x)
+            assert mass_balance_residual(st, prev, s) < 16 * st.solver.rtol
         prev = s
 
 
 # ---- failure handling ----------------------------------------------------------------------
 def rupturing_scene():
     """Rigid substrate, gap ramped to a negative clearance: the film must hit zero at the tip."""
-    return Scene(indenter=Sphere(1.0), substrate=Rigid(), fluid=Fluid(1.0),
-                 motion=Motion(gap=RampHold(h0=0.2, h_end=-0.5, t1=1.0)), domain=Domain(2.0))
+    return Scene(
+        indenter=Sphere(1.0),
+        substrate=Rigid(),
+        fluid=Fluid(1.0),
+        motion=Motion(gap=RampHold(h0=0.2, h_end=-0.5, t1=1.0)),
+        domain=Domain(2.0),
+    )
 
 
 def _summary_rows(folder):
@@ -172,6 +186,7 @@ def _check_series(folder):
     times = [float(ds.get("timestep")) for ds in root.iter("DataSet")]
     assert names and times == sorted(times)
     import meshio
+
     for n in names:
         assert (folder / n).is_file()
         m = meshio.read(folder / n)
@@ -180,23 +195,25 @@ def _check_series(folder):
     return times
 
 
-def test_rupture_leaves_readable_output(tmp_path):
-    out = tmp_path / "run"
+def test_rupture_leaves_readable_output(out_dir):
+    out = out_dir
     with pytest.raises(FilmRuptureError) as info:
         run_to_folder(rupturing_scene(), out, mesh="coarse", t_end=1.0, dt=0.05, store_every=2, log=quiet)
     exc = info.value
-    hc_zero = 0.2 / 0.7                                         # hc(t) = 0 here
+    # not a solver-dependent time: on a rigid substrate d = h exactly, so the tip film is
+    # hc(t) and must vanish in the step that crosses hc = 0, whatever the solver
+    hc_zero = 0.2 / 0.7  # hc(t) = 0 here
     assert hc_zero - 1e-9 < exc.t <= hc_zero + 0.05 + 1e-9
-    assert math.hypot(*exc.where) < 0.5                        # at the tip
+    assert math.hypot(*exc.where) < 0.5  # at the tip
     assert "ruptured" in str(exc) and "smaller dt" in str(exc)
     res = exc.result
     rows = _summary_rows(out)
-    assert rows[0][0] == "t" and len(rows) - 1 == len(res.t)   # every state reached, nothing more
+    assert rows[0][0] == "t" and len(rows) - 1 == len(res.t)  # every state reached, nothing more
     ts = [float(r[0]) for r in rows[1:]]
     assert ts == pytest.approx(list(res.t)) and ts[-1] < exc.t
-    assert all(float(r[5]) > 0 for r in rows[1:])              # film_min column: all positive
+    assert all(float(r[5]) > 0 for r in rows[1:])  # film_min column: all positive
     times = _check_series(out)
-    assert times[-1] == pytest.approx(ts[-1])                  # last good state written
+    assert times[-1] == pytest.approx(ts[-1])  # last good state written
     for png in ("centreline.png", "fields.png"):
         assert (out / png).stat().st_size > 1000
     ck = load_checkpoint(out)
@@ -205,11 +222,27 @@ def test_rupture_leaves_readable_output(tmp_path):
 
 def test_cli_exit_status_3_on_rupture(tmp_path, capsys):
     scene = tmp_path / "rupture.toml"
-    scene.write_text('[substrate]\nkind = "rigid"\n[fluid]\nbeta = 1.0\n'
-                     '[motion.gap]\nkind = "ramp_hold"\nh0 = 0.2\nh_end = -0.5\nt1 = 1.0\n')
+    scene.write_text(
+        '[substrate]\nkind = "rigid"\n[fluid]\nbeta = 1.0\n'
+        '[motion.gap]\nkind = "ramp_hold"\nh0 = 0.2\nh_end = -0.5\nt1 = 1.0\n'
+    )
     from femehl.cli import main
-    code = main(["run", str(scene), "--mesh", "coarse", "--dt", "0.05", "--t-end", "1",
-                 "--out", str(tmp_path / "o"), "--quiet"])
+
+    code = main(
+        [
+            "run",
+            str(scene),
+            "--mesh",
+            "coarse",
+            "--dt",
+            "0.05",
+            "--t-end",
+            "1",
+            "--out",
+            str(tmp_path / "o"),
+            "--quiet",
+        ]
+    )
     assert code == 3
     err = capsys.readouterr().err
     assert "ruptured" in err and "t =" in err
@@ -248,9 +281,9 @@ def test_resume_reproduces_an_uninterrupted_run(tmp_path):
     assert sa.t == pytest.approx(1.2) and sb.t == pytest.approx(1.2) and sa.step == sb.step == 12
     for f in ("p", "w", "d"):
         np.testing.assert_allclose(getattr(sa, f), getattr(sb, f), rtol=1e-10, atol=1e-14)
-    assert (a / "summary.csv").read_text() == (b / "summary.csv").read_text()   # appended, same rows
+    assert (a / "summary.csv").read_text() == (b / "summary.csv").read_text()  # appended, same rows
     ta, tb = _check_series(a), _check_series(b)
-    assert set(tb) <= set(ta) and ta == sorted(ta)        # numbering continued (+ the t = 0.5 state)
+    assert set(tb) <= set(ta) and ta == sorted(ta)  # numbering continued (+ the t = 0.5 state)
 
 
 def test_resume_after_a_run_that_went_past_its_checkpoint(tmp_path):
@@ -276,11 +309,14 @@ def test_resume_after_a_run_that_went_past_its_checkpoint(tmp_path):
     assert times == pytest.approx([0.0, 0.3, 0.6, 0.7])
 
 
-@pytest.mark.parametrize("change, where", [
-    (dict(scene=presets.paper_sphere(beta=20.0)), "scene.fluid.beta"),
-    (dict(mesh="medium"), "discretization"),
-    (dict(method="fd", mesh=None), "method"),
-])
+@pytest.mark.parametrize(
+    "change, where",
+    [
+        (dict(scene=presets.paper_sphere(beta=20.0)), "scene.fluid.beta"),
+        (dict(mesh="medium"), "discretization"),
+        (dict(method="fd", mesh=None), "method"),
+    ],
+)
 def test_resume_refuses_a_different_run(tmp_path, change, where):
     sc = presets.paper_sphere()
     run_to_folder(sc, tmp_path, t_end=0.1, **RUN)
@@ -302,6 +338,7 @@ def test_resume_without_checkpoint(tmp_path):
 
 def test_cli_resume(tmp_path):
     from femehl.cli import main
+
     out = str(tmp_path / "o")
     common = ["run", "--mesh", "coarse", "--dt", "0.05", "--store-every", "2", "--out", out, "--quiet"]
     assert main(common + ["--t-end", "0.2"]) == 0

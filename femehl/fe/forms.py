@@ -1,4 +1,4 @@
-"""The weak form of the Reynolds equation, in scikit-fem forms (design.md section 4).
+"""The weak form of the Reynolds equation, in scikit-fem forms (docs/design.md, section 4).
 
 Find p in P1, p = 0 on r = L, such that for every P1 test function q
 

@@ -112,20 +112,51 @@ class Result:
             raise SceneError("points must be finite.")
         return pts
 
+    # Inside the domain the fields are the discretization's (FE: P1 pressure, element-
+    # constant film and deflection; FD: bilinear).  Outside it (r > L; line contact
+    # |x| > L) they are the model's own: p = 0 (the pressure vanishes beyond the rim),
+    # w from the substrate's operator at those points (the exact Boussinesq integral of
+    # the discrete pressure for a half space; -p/k = 0 for Winkler) and d = hc + s - w.
+    # So pressure, deflection and film are defined and consistent everywhere.
+    def _outside(self, pts):
+        return self.disc.outside(pts)
+
+    def _model_deflection(self, state, pts):
+        rows = self.scene.substrate.deflection_rows(self.disc, pts)
+        return -np.asarray(rows @ np.asarray(state.p)[self.disc.free_index]).ravel()
+
     def pressure_at(self, points, t: float) -> np.ndarray:
         """Pressure at ``points`` (n, 2) and time ``t`` (normalized); 0 outside the domain."""
         pts = self._points(points)
-        return sum(wt * self.disc.pressure_at(s.p, pts) for s, wt in self._bracket(t))
-
-    def film_at(self, points, t: float) -> np.ndarray:
-        """Film thickness d = h - w at ``points`` (n, 2) and time ``t``."""
-        pts = self._points(points)
-        return sum(wt * self.disc.film_at(s.d, pts) for s, wt in self._bracket(t))
+        out = self._outside(pts)
+        val = sum(wt * self.disc.pressure_at(s.p, pts) for s, wt in self._bracket(t))
+        return np.where(out, 0.0, val)
 
     def deflection_at(self, points, t: float) -> np.ndarray:
         """Surface deflection w (negative under pressure) at ``points`` and time ``t``."""
         pts = self._points(points)
-        return sum(wt * self.disc.deflection_at(s.w, pts) for s, wt in self._bracket(t))
+        out = self._outside(pts)
+        val = np.zeros(pts.shape[0])
+        for s, wt in self._bracket(t):
+            v = np.empty(pts.shape[0])
+            v[~out] = self.disc.deflection_at(s.w, pts[~out])
+            if out.any():
+                v[out] = self._model_deflection(s, pts[out])
+            val += wt * v
+        return val
+
+    def film_at(self, points, t: float) -> np.ndarray:
+        """Film thickness d = h - w at ``points`` (n, 2) and time ``t``."""
+        pts = self._points(points)
+        out = self._outside(pts)
+        val = np.zeros(pts.shape[0])
+        for s, wt in self._bracket(t):
+            v = np.empty(pts.shape[0])
+            v[~out] = self.disc.film_at(s.d, pts[~out])
+            if out.any():
+                v[out] = s.hc + self.disc.gap(pts[out]) - self._model_deflection(s, pts[out])
+            val += wt * v
+        return val
 
     # ---- tables -------------------------------------------------------------
     def summary(self) -> dict:
@@ -138,7 +169,15 @@ class Result:
 
     def value_at(self, name: str, t: float) -> float:
         """A per-step scalar (e.g. "load") at time ``t``, linear in time between steps."""
-        return float(np.interp(t, self.t, getattr(self, name)))
+        if name not in _SCALARS:
+            raise SceneError(f"unknown quantity {name!r}: value_at takes one of {list(_SCALARS)}.")
+        ts = self.t
+        t = float(t)
+        tol = 1e-9 * max(1.0, abs(ts[-1]))
+        if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
+            raise SceneError(f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}]: give a time "
+                             "the run reached.")
+        return float(np.interp(t, ts, getattr(self, name)))
 
     def save(self, folder) -> "pathlib.Path":  # noqa: F821
         """Write the summary CSV, centreline PNG and field series to ``folder``."""

@@ -598,7 +598,8 @@ def test_cli_writes_si_summary(tmp_path, capsys):
         ]
     )
     assert rc == 0
-    assert "imposed_load=True" in capsys.readouterr().out
+    cap = capsys.readouterr()
+    assert "imposed_load=True" in cap.err          # the run report goes to stderr (logging)
     with open(out / "summary_si.csv") as fh:
         rows = list(csv.reader(fh))
     assert rows[0][:4] == ["t_s", "hc_m", "load_N", "film_center_m"]

@@ -218,6 +218,11 @@ class FDDisc:
         chi += quad_influence(points, mirror)
         return np.asarray(self.E.T @ chi.T).T
 
+    def outside(self, points):
+        """True where a point lies beyond the domain r <= L."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return np.hypot(pts[:, 0], pts[:, 1]) > self.grid.L * (1.0 + 1e-9)
+
     # ---- fields for results and writers -----------------------------------------------
     def pressure_at(self, p, points):
         return self.grid.pressure_at(p, points)

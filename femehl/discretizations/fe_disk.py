@@ -198,16 +198,28 @@ class FEDisc:
             X += triangle_influence(pts, self.tri * np.array([1.0, -1.0]))
         return np.asarray(self.P[:, self.free].T @ X.T).T
 
+    def outside(self, points):
+        """True where a point lies beyond the domain r <= L."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return np.hypot(pts[:, 0], pts[:, 1]) > self.L * (1.0 + 1e-9)
+
     # ---- fields for results and writers -----------------------------------------------
     def pressure_at(self, p, points):
         """P1 interpolation; 0 outside the mesh (p = 0 beyond r = L)."""
         return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()
 
     def _cell_value(self, values, points):
+        """Element values at points; a point of the disk between the polygonal rim and the
+        circle r = L takes its nearest element's value, a point beyond r = L is NaN."""
         pts, e = self._locate(points)
         out = np.full(pts.shape[0], np.nan)
         ok = e >= 0
         out[ok] = np.asarray(values)[e[ok]]
+        rim = ~ok & ~self.outside(pts)
+        if rim.any():
+            from scipy.spatial import cKDTree
+
+            out[rim] = np.asarray(values)[cKDTree(self.centroids).query(pts[rim])[1]]
         return out
 
     def film_at(self, d, points):

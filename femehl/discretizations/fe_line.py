@@ -133,6 +133,10 @@ class LineDisc:
     def boussinesq_rows(self, points):
         return self.boussinesq()
 
+    def outside(self, points):
+        """True where a point lies beyond the domain |x| <= L."""
+        return np.abs(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0]) > self.L * (1.0 + 1e-9)
+
     # ---- fields for results and writers -----------------------------------------------
     def pressure_at(self, p, points):
         return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()

@@ -187,7 +187,7 @@ def worker(spec):
     out = dict(spec)
     # the dense influence operator in use: FE elements x free nodes, FD nodes x free nodes
     D = st.C
-    mv = []                      # matvec timings, interleaved with the stepping (same load)
+    mv = []  # matvec timings, interleaved with the stepping (same load)
     if isinstance(D, np.ndarray):
         x = np.random.default_rng(0).random(D.shape[1])
         for _ in range(3):

@@ -254,8 +254,9 @@ def run_case(
             row["steps"] = state.step
             osc.update(state.t, state.film_min, state.d)
             if prev is not None:
-                res = mass_balance_residual(stepper, prev, state,
-                                            "implicit" if solver == "relax" else "lagged")
+                res = mass_balance_residual(
+                    stepper, prev, state, "implicit" if solver == "relax" else "lagged"
+                )
                 row["mass_residual_max"] = max(row["mass_residual_max"], res)
                 if solver == "relax":
                     iters.append(state.info.get("iterations", 0))

@@ -56,7 +56,9 @@ def main(out="femehl-out/custom_shape", t_end: float = 5.0, mesh: str = "coarse"
         ``wall_s``, ``result``.
     """
     t0 = time.perf_counter()
-    res = run_to_folder(scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10)
+    res = run_to_folder(
+        scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10, overwrite=True
+    )
     o = {
         "load": float(res.load[-1]),
         "film_center": float(res.film_center[-1]),

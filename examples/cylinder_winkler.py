@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from femehl.line import LineScene, solve_line
+from femehl.api import solve_line
+from femehl.line import LineScene
 from femehl.line_steady import steady_line
 from femehl.scene import Motion, RampHold, TanhStart
 

@@ -44,7 +44,9 @@ def main(
         ``load``, ``film_center``, ``film_min``, ``film_min_at`` (x, y), ``wall_s``, ``result``.
     """
     t0 = time.perf_counter()
-    res = run_to_folder(scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10)
+    res = run_to_folder(
+        scene(), out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10, overwrite=True
+    )
     s = res.summary()
     o = {
         "load": float(res.load[-1]),

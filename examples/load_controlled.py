@@ -52,7 +52,7 @@ def main(
     """
     t0 = time.perf_counter()
     sc = scene(F)
-    res = run_to_folder(sc, out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10)
+    res = run_to_folder(sc, out, method="fe", mesh=mesh, t_end=t_end, dt=dt, store_every=10, overwrite=True)
     hc_hertz = -((F / HERTZ_LOAD) ** (2.0 / 3.0))
     o = {
         "load": float(res.load[-1]),

@@ -12,23 +12,75 @@ reference).  Quick start::
     result.pressure_at([[0.0, 0.0], [-1.0, 0.0]], t=2.0)
 """
 
-from . import indenters, presets
-from .api import make_stepper, methods, solve, steps
+from . import indenters, line, presets
+from .api import make_stepper, methods, solve, solve_line, steps
 from .discretizations import METHODS
-from .errors import (FemehlError, FilmRuptureError, MeshError, SceneError, SceneFileError,
-                     SingularSystemError, SolverError)
+from .errors import (
+    FemehlError,
+    FilmRuptureError,
+    MeshError,
+    SceneError,
+    SceneFileError,
+    SingularSystemError,
+    SolverError,
+)
 from .indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
 from .result import Result
-from .scene import (Constant, Dimensional, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid,
-                    Scene, Sphere, Table, TanhStart, Winkler)
+from .scene import (
+    Constant,
+    Dimensional,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Motion,
+    RampHold,
+    Rigid,
+    Scene,
+    Sphere,
+    Table,
+    TanhStart,
+    Winkler,
+)
 from .stepping import State, march
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "presets", "indenters", "solve", "steps", "make_stepper", "march", "METHODS", "methods", "Result", "State",
-    "Scene", "Sphere", "Ellipsoid", "FlatPunch", "Shape", "HeightMap", "INDENTERS", "HalfSpace", "Rigid", "Winkler", "Fluid", "Motion", "Domain",
-    "Dimensional", "Constant", "Table", "RampHold", "TanhStart",
-    "FemehlError", "SceneError", "SceneFileError", "MeshError", "SolverError",
-    "FilmRuptureError", "SingularSystemError",
+    "presets",
+    "indenters",
+    "line",
+    "solve",
+    "solve_line",
+    "steps",
+    "make_stepper",
+    "march",
+    "METHODS",
+    "methods",
+    "Result",
+    "State",
+    "Scene",
+    "Sphere",
+    "Ellipsoid",
+    "FlatPunch",
+    "Shape",
+    "HeightMap",
+    "INDENTERS",
+    "HalfSpace",
+    "Rigid",
+    "Winkler",
+    "Fluid",
+    "Motion",
+    "Domain",
+    "Dimensional",
+    "Constant",
+    "Table",
+    "RampHold",
+    "TanhStart",
+    "FemehlError",
+    "SceneError",
+    "SceneFileError",
+    "MeshError",
+    "SolverError",
+    "FilmRuptureError",
+    "SingularSystemError",
 ]

@@ -9,23 +9,21 @@ goes through :func:`run_loop`.  The stepping itself is the generator
 from __future__ import annotations
 
 import inspect
-from typing import Callable, Iterator
+from collections.abc import Callable, Iterator
 
 from .errors import SceneError
 from .result import Result
-from .scene import Scene
+from .scene import Scene, SceneEffects
 from .stepping import State, march
 
-__all__ = ["make_stepper", "steps", "solve", "run_loop", "methods"]
+__all__ = ["make_stepper", "steps", "solve", "solve_line", "run_loop", "methods"]
+
 
 def _registry():
     from .discretizations import METHODS, method_class
 
-    method_class("fe")       # imports the registered discretizations
+    method_class("fe")  # imports the registered discretizations
     return METHODS
-
-
-DEFAULT_METHOD = "fe"
 
 
 def make_stepper(scene, method: str | None = None, **options):
@@ -38,14 +36,14 @@ def make_stepper(scene, method: str | None = None, **options):
     """
     from .core.linsolve import LINEAR_SOLVERS
     from .core.stepper import LaggedStepper
-    from .line import LineScene
 
     methods = _registry()
-    if not isinstance(scene, (Scene, LineScene)):
-        raise SceneError(f"scene must be a femehl.Scene (or femehl.line.LineScene), got "
-                         f"{type(scene).__name__}.")
+    if not isinstance(scene, SceneEffects):
+        raise SceneError(
+            f"scene must be a femehl.Scene (or femehl.line.LineScene), got {type(scene).__name__}."
+        )
     if method is None:
-        method = "line" if isinstance(scene, LineScene) else DEFAULT_METHOD
+        method = scene.default_method
     if not isinstance(method, str) or method not in methods:
         raise SceneError(f"unknown method {method!r}: choose one of {sorted(methods)}.")
     cls = methods[method]
@@ -56,8 +54,9 @@ def make_stepper(scene, method: str | None = None, **options):
     step_keys = {"scheme", "linear_solver", "terms"} | solver_keys
     unknown = set(options) - disc_keys - step_keys
     if unknown:
-        raise SceneError(f"method {method!r} does not take {sorted(unknown)}; it takes "
-                         f"{sorted(disc_keys | step_keys)}.")
+        raise SceneError(
+            f"method {method!r} does not take {sorted(unknown)}; it takes {sorted(disc_keys | step_keys)}."
+        )
     disc = cls(scene, **{k: v for k, v in options.items() if k in disc_keys})
     return LaggedStepper(disc, **{k: v for k, v in options.items() if k in step_keys})
 
@@ -67,16 +66,22 @@ def methods() -> list[str]:
     return sorted(_registry())
 
 
-def steps(scene: Scene, t_end: float, dt: float, method: str | None = None,
-          **options) -> Iterator[State]:
+def steps(scene: Scene, t_end: float, dt: float, method: str | None = None, **options) -> Iterator[State]:
     """Generator of States, the initial one first (see :func:`femehl.stepping.march`)."""
     stepper = make_stepper(scene, method, **options)
     yield from march(stepper, t_end, dt)
 
 
-def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: float = 0.01,
-          store_every: int = 1, callback: Callable[[State], None] | None = None,
-          **options) -> Result:
+def solve(
+    scene: Scene,
+    method: str | None = None,
+    *,
+    t_end: float = 5.0,
+    dt: float = 0.01,
+    store_every: int = 1,
+    callback: Callable[[State], None] | None = None,
+    **options,
+) -> Result:
     """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.result.Result`.
 
     Parameters
@@ -105,8 +110,15 @@ def solve(scene: Scene, method: str | None = None, *, t_end: float = 5.0, dt: fl
     return run_loop(stepper, t_end, dt, store_every=store_every, on_state=callback)
 
 
-def run_loop(stepper, t_end: float, dt: float, *, start: State | None = None,
-             store_every: int = 1, on_state: Callable[[State], None] | None = None) -> Result:
+def run_loop(
+    stepper,
+    t_end: float,
+    dt: float,
+    *,
+    start: State | None = None,
+    store_every: int = 1,
+    on_state: Callable[[State], None] | None = None,
+) -> Result:
     """The one driver loop: march ``stepper`` and feed every State to a Result and ``on_state``.
 
     Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
@@ -134,6 +146,27 @@ def run_loop(stepper, t_end: float, dt: float, *, start: State | None = None,
     finally:
         if last is not None and store_every > 0 and not last[1]:
             result._stored.append(last[0])
-        result.info.update(getattr(stepper, "info", {}))      # counters as at the end of the run
+        result.info.update(getattr(stepper, "info", {}))  # counters as at the end of the run
         result.info["steps"] = result.nsteps
     return result
+
+
+def solve_line(
+    scene,
+    t_end: float,
+    dt: float,
+    *,
+    store_every: int = 1,
+    callback: Callable[[State], None] | None = None,
+    **options,
+) -> Result:
+    """Run a line-contact scene: ``solve(scene, method="line", ...)`` with positional times.
+
+    ``options`` are the discretization's (``n_elements``, ``grading``, ``fine``, see
+    :class:`femehl.discretizations.fe_line.LineDisc`) and the stepper's (``scheme``).
+    The Result's ``disc.x`` / ``disc.xc`` are the nodes (where ``State.p`` lives) and the
+    element centroids (``State.d``, ``State.w``).
+    """
+    return solve(
+        scene, method="line", t_end=t_end, dt=dt, store_every=store_every, callback=callback, **options
+    )

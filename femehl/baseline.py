@@ -13,9 +13,10 @@ equation and elasticity with an under-relaxation factor on the pressure
     until ||p* - p_old|| / ||p*|| < tol        (at most max_iter times)
 
 It is built on the FE discretization (same mesh, same operators K, Bx, M and
-C of femehl's stepper for method "fe", which it wraps and does not modify), so the only difference to femehl's scheme is *how* one time step is
-solved: a fixed-point iteration between Reynolds and elasticity, converged
-to a fully implicit step (K evaluated at d^{k+1}), instead of ONE linear
+C of femehl's stepper for method "fe", which it wraps and does not modify),
+so the only difference to femehl's scheme is *how* one time step is solved:
+a fixed-point iteration between Reynolds and elasticity, converged to a fully
+implicit step (K evaluated at d^{k+1}), instead of ONE linear
 system with the coefficients lagged.  A step that does not converge raises
 :class:`~femehl.errors.RelaxationDivergedError` with the iteration count.
 
@@ -62,7 +63,7 @@ def mass_balance_residual(stepper, prev: State, new: State, coefficient: str = "
     couette = np.zeros_like(squeeze)
     if new.V != 0.0:
         couette = new.V * (disc.couette() @ new.d)
-    D = disc.poiseuille(d_coef, d_coef ** 3, 3.0 * d_coef ** 2)
+    D = disc.poiseuille(d_coef, d_coef**3, 3.0 * d_coef**2)
     r = stepper.scene.fluid.beta * (D @ p) + couette + squeeze
     scale = float(np.linalg.norm(squeeze) + np.linalg.norm(couette))
     rn = float(np.linalg.norm(r))
@@ -95,8 +96,15 @@ class RelaxationStepper:
 
     method = "relax"
 
-    def __init__(self, scene: Scene, mesh="coarse", omega: float = 0.1, tol: float = 1e-6,
-                 max_iter: int = 200, **fe_options):
+    def __init__(
+        self,
+        scene: Scene,
+        mesh="coarse",
+        omega: float = 0.1,
+        tol: float = 1e-6,
+        max_iter: int = 200,
+        **fe_options,
+    ):
         from .api import make_stepper
 
         try:
@@ -120,8 +128,15 @@ class RelaxationStepper:
         self.max_iter = max_iter
         self.info = dict(self.fe.info)
         self._Bx = None
-        self.info.update(method="relax", omega=omega, tol=tol, max_iter=max_iter,
-                         iterations=0, steps=0, max_step_iterations=0)
+        self.info.update(
+            method="relax",
+            omega=omega,
+            tol=tol,
+            max_iter=max_iter,
+            iterations=0,
+            steps=0,
+            max_step_iterations=0,
+        )
 
     def initial_state(self) -> State:
         return self.fe.initial_state()
@@ -152,20 +167,26 @@ class RelaxationStepper:
                     f"relaxation (omega = {self.omega:g}) diverged at t = {t_new:.6g} after {it} "
                     f"iterations: the iterate's film became {d[bad]:.3g} <= 0 at (x, y) = "
                     f"({x:.3g}, {y:.3g}). Try a smaller omega (more iterations) -- or femehl's "
-                    "non-iterative scheme (method 'fe').", t=t_new, iterations=it)
+                    "non-iterative scheme (method 'fe').",
+                    t=t_new,
+                    iterations=it,
+                )
             rhs = -M @ (d - d_old) / dt
             if Bx is not None:
                 rhs -= V * (Bx @ d)
-            K = disc.poiseuille(d, d ** 3)
+            K = disc.poiseuille(d, d**3)
             p_star = spla.spsolve((fe.beta * K).tocsc(), rhs)
             ns = float(np.linalg.norm(p_star))
-            change = float(np.linalg.norm(p_star - p)) / ns if ns > 0.0 else (
-                0.0 if not np.any(p) else math.inf)
+            change = (
+                float(np.linalg.norm(p_star - p)) / ns if ns > 0.0 else (0.0 if not np.any(p) else math.inf)
+            )
             if not np.isfinite(change):
                 raise RelaxationDivergedError(
                     f"relaxation (omega = {self.omega:g}) produced a non-finite pressure at "
                     f"t = {t_new:.6g} after {it} iterations. Try a smaller omega.",
-                    t=t_new, iterations=it)
+                    t=t_new,
+                    iterations=it,
+                )
             p = (1.0 - self.omega) * p + self.omega * p_star
             if change < self.tol:
                 break
@@ -174,9 +195,20 @@ class RelaxationStepper:
                     f"relaxation (omega = {self.omega:g}) did not converge at t = {t_new:.6g}: "
                     f"pressure change still {change:.3g} > tol = {self.tol:g} after {it} iterations. "
                     "Try another omega, more iterations, a larger dt -- or femehl's non-iterative "
-                    "scheme (method 'fe').", t=t_new, iterations=it)
+                    "scheme (method 'fe').",
+                    t=t_new,
+                    iterations=it,
+                )
         self.info["iterations"] += it
         self.info["steps"] += 1
         self.info["max_step_iterations"] = max(self.info["max_step_iterations"], it)
-        return fe._state(state.step + 1, t_new, hc, V, p, d_prev=state.d, dt_prev=dt,
-                         info={"iterations": it, "change": change})
+        return fe._state(
+            state.step + 1,
+            t_new,
+            hc,
+            V,
+            p,
+            d_prev=state.d,
+            dt_prev=dt,
+            info={"iterations": it, "change": change},
+        )

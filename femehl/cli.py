@@ -39,23 +39,31 @@ def _parser():
     sub = p.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a scene (default: the paper's sphere) into an output folder")
     r.add_argument("scene", nargs="?", help="TOML scene file (default: built-in paper case)")
-    r.add_argument("--method", choices=["fe", "fd", "line"],
-                   help="solver (default fe; line contact scenes: line)")
+    r.add_argument(
+        "--method", choices=["fe", "fd", "line"], help="solver (default fe; line contact scenes: line)"
+    )
     r.add_argument("--mesh", help="FE mesh: coarse|medium|fine|xfine or a mesh file (default medium)")
     r.add_argument("--dr", type=float, help="FD radial step (default 0.0125)")
     r.add_argument("--dtheta-divisions", type=int, help="FD: dtheta = pi/N (default 36)")
     r.add_argument("--n-elements", type=int, help="line contact: number of elements (default 400)")
     r.add_argument("--dt", type=float, help="time step (default 0.01)")
-    r.add_argument("--scheme", choices=["euler", "bdf2"],
-                   help="FE time scheme: euler (the paper's, default) or bdf2 (second order)")
+    r.add_argument(
+        "--scheme",
+        choices=["euler", "bdf2"],
+        help="FE time scheme: euler (the paper's, default) or bdf2 (second order)",
+    )
     r.add_argument("--t-end", type=float, help="end time (default 5)")
     r.add_argument("--store-every", type=int, help="write fields every N steps (default 10)")
     r.add_argument("--out", help=f"output folder (default {DEFAULT_OUT}/<scene name>)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
-    r.add_argument("--resume", action="store_true",
-                   help="continue the run in the output folder from its checkpoint.npz")
-    r.add_argument("--overwrite", action="store_true",
-                   help="replace the run already in the output folder (its femehl files only)")
+    r.add_argument(
+        "--resume", action="store_true", help="continue the run in the output folder from its checkpoint.npz"
+    )
+    r.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the run already in the output folder (its femehl files only)",
+    )
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument("what", choices=["accuracy", "stress"], help="which study")
     b.add_argument("rest", nargs=argparse.REMAINDER)
@@ -102,7 +110,7 @@ def _run(args, argv=()):
     dim = None
     if args.scene:
         scene, run = load_scene_file(args.scene)
-        dim = run.pop("_dimensional", None)      # the scene was stated in SI units
+        dim = run.pop("_dimensional", None)  # the scene was stated in SI units
         name = args.scene.rsplit("/", 1)[-1].rsplit(".", 1)[0]
     else:
         scene, run = presets.paper_sphere(), {}
@@ -115,16 +123,19 @@ def _run(args, argv=()):
     method = args.method or run.pop("method", "line" if is_line else "fe")
     run.pop("method", None)
     if is_line and method != "line":
-        raise FemehlError(f"--method {method} does not apply to line contact; its method is 'line' "
-                          "(leave --method out).")
+        raise FemehlError(
+            f"--method {method} does not apply to line contact; its method is 'line' (leave --method out)."
+        )
     if method == "line" and not is_line:
-        raise FemehlError("--method line is for line contact scenes ([indenter] kind = \"cylinder\"); "
-                          "use fe or fd for this scene.")
+        raise FemehlError(
+            '--method line is for line contact scenes ([indenter] kind = "cylinder"); '
+            "use fe or fd for this scene."
+        )
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
     for key in ("scheme", "mesh", "n_elements", "dt", "t_end", "store_every"):
         v = getattr(args, key)
-        if v is not None and not (key == "scheme" and method == "fd"):    # fd: euler, its own scheme
+        if v is not None and not (key == "scheme" and method == "fd"):  # fd: euler, its own scheme
             run[key] = v
     if args.dr is not None:
         run["dr"] = check_step("--dr", args.dr)
@@ -139,22 +150,35 @@ def _run(args, argv=()):
         run.setdefault("mesh", "medium")
     out = args.out or f"{DEFAULT_OUT}/{name}"
     try:
-        res = run_to_folder(scene, out, method=method, t_end=run.pop("t_end", 5.0), dt=run.pop("dt", 0.01),
-                            store_every=run.pop("store_every", 10), progress=not args.quiet,
-                            resume=resume, overwrite=overwrite, **run)
+        res = run_to_folder(
+            scene,
+            out,
+            method=method,
+            t_end=run.pop("t_end", 5.0),
+            dt=run.pop("dt", 0.01),
+            store_every=run.pop("store_every", 10),
+            progress=not args.quiet,
+            resume=resume,
+            overwrite=overwrite,
+            **run,
+        )
     except KeyboardInterrupt:
         return _interrupted(out, argv)
     from .output.plots import FIGURES
 
     files = ", ".join(["fields.pvd"] + [name for name, _ in FIGURES[res.disc.dimension]])
-    print(f"femehl: done in {res.info['wall_s']:.1f} s ({res.info['unknowns']} unknowns, "
-          f"{res.nsteps} steps); wrote {out}/summary.csv, {files}")
+    print(
+        f"femehl: done in {res.info['wall_s']:.1f} s ({res.info['unknowns']} unknowns, "
+        f"{res.nsteps} steps); wrote {out}/summary.csv, {files}"
+    )
     if dim is not None:
         print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
     for t in sorted({1.0, float(res.t[-1])}):
         if t <= res.t[-1] + 1e-9:
-            print(f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
-                  f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}")
+            print(
+                f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
+                f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}"
+            )
     return 0
 
 
@@ -163,6 +187,7 @@ class _SummaryFile:
 
     def __init__(self, folder):
         import pathlib
+
         self.path = pathlib.Path(folder) / "summary.csv"
 
     def summary(self) -> dict:
@@ -202,8 +227,10 @@ def _bench(args):
     root = pathlib.Path(__file__).resolve().parents[1] / "benchmarks"
     script = root / f"{args.what}.py"
     if not script.exists():
-        raise FemehlError(f"benchmark script {script} not found: benchmarks ship with the source "
-                          "checkout (git clone), not with an installed wheel.")
+        raise FemehlError(
+            f"benchmark script {script} not found: benchmarks ship with the source "
+            "checkout (git clone), not with an installed wheel."
+        )
     sys.argv = [str(script)] + list(args.rest)
     runpy.run_path(str(script), run_name="__main__")
     return 0
@@ -248,8 +275,10 @@ def _interrupted(out, argv) -> int:
     import pathlib
 
     if out is not None and (pathlib.Path(out) / "checkpoint.npz").is_file():
-        print(f"femehl: interrupted; what was written is in {out}. To go on:\n  "
-              f"{resume_command(argv, out)}", file=sys.stderr)
+        print(
+            f"femehl: interrupted; what was written is in {out}. To go on:\n  {resume_command(argv, out)}",
+            file=sys.stderr,
+        )
     else:
         print("femehl: interrupted before the run wrote a checkpoint; nothing to resume.", file=sys.stderr)
     return EXIT_INTERRUPTED

@@ -89,7 +89,9 @@ class Sphere:
     si_units: ClassVar[dict] = {"R": "curvature"}
 
     def __post_init__(self):
-        object.__setattr__(self, "R", _positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization."))
+        object.__setattr__(
+            self, "R", _positive("Sphere radius R", self.R, "Use R = 1 in the paper's normalization.")
+        )
 
     def gap(self, x, y):
         """Rigid gap shape s(x, y) (>= 0, zero at the tip), broadcast over arrays."""
@@ -100,9 +102,11 @@ class Sphere:
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose R so that the gap's rise L^2/(2R) on the domain r <= L lies in ``rise``."""
         lo, hi = _radius_range(L, rise)
-        return (f"Use a radius {lo:.3g} <= R <= {hi:.3g} for the domain radius L = {L:g} "
-                f"(s(L) = L^2/(2R) must lie in [{rise[0]:g}, {rise[1]:g}]; R = 1 in the paper's "
-                "normalization), or change L.")
+        return (
+            f"Use a radius {lo:.3g} <= R <= {hi:.3g} for the domain radius L = {L:g} "
+            f"(s(L) = L^2/(2R) must lie in [{rise[0]:g}, {rise[1]:g}]; R = 1 in the paper's "
+            "normalization), or change L."
+        )
 
 
 @dataclass(frozen=True)
@@ -144,9 +148,11 @@ class Ellipsoid:
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose Rx, Ry so that the gap's rise on the domain r <= L lies in ``rise``."""
         lo, hi = _radius_range(L, rise)
-        return (f"Use radii of curvature with {lo:.3g} <= min(Rx, Ry) and max(Rx, Ry) <= {hi:.3g} "
-                f"for the domain radius L = {L:g} (the rise L^2/(2R) must lie in "
-                f"[{rise[0]:g}, {rise[1]:g}]), or change L.")
+        return (
+            f"Use radii of curvature with {lo:.3g} <= min(Rx, Ry) and max(Rx, Ry) <= {hi:.3g} "
+            f"for the domain radius L = {L:g} (the rise L^2/(2R) must lie in "
+            f"[{rise[0]:g}, {rise[1]:g}]), or change L."
+        )
 
 
 @dataclass(frozen=True)
@@ -172,11 +178,24 @@ class FlatPunch:
     si_units: ClassVar[dict] = {"a": "length", "edge_radius": "curvature"}
 
     def __post_init__(self):
-        object.__setattr__(self, "a", _positive("FlatPunch radius a", self.a, "Give the radius of the flat face; "
-                  "for a = 0 use Sphere(R=edge_radius)."))
-        object.__setattr__(self, "edge_radius", _positive("FlatPunch edge_radius", self.edge_radius,
-                  "A sharp edge makes the pressure singular: use a rounded edge, "
-                  "edge_radius > 0 (e.g. 0.2)."))
+        object.__setattr__(
+            self,
+            "a",
+            _positive(
+                "FlatPunch radius a",
+                self.a,
+                "Give the radius of the flat face; for a = 0 use Sphere(R=edge_radius).",
+            ),
+        )
+        object.__setattr__(
+            self,
+            "edge_radius",
+            _positive(
+                "FlatPunch edge_radius",
+                self.edge_radius,
+                "A sharp edge makes the pressure singular: use a rounded edge, edge_radius > 0 (e.g. 0.2).",
+            ),
+        )
 
     def gap(self, x, y):
         """Rigid gap shape s(x, y) (>= 0, zero on the flat face), broadcast over arrays."""
@@ -188,12 +207,16 @@ class FlatPunch:
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose a and edge_radius so that the rise (L - a)^2/(2 edge_radius) lies in ``rise``."""
         if self.a >= L:
-            return (f"The flat face (a = {self.a:g}) covers the whole domain r <= L = {L:g}: use "
-                    f"a < L, or a domain radius L > a (the paper's rule: L about 2 contact radii).")
+            return (
+                f"The flat face (a = {self.a:g}) covers the whole domain r <= L = {L:g}: use "
+                f"a < L, or a domain radius L > a (the paper's rule: L about 2 contact radii)."
+            )
         lo, hi = _radius_range(L - self.a, rise)
-        return (f"Use {lo:.3g} <= edge_radius <= {hi:.3g} for a = {self.a:g} and L = {L:g} "
-                f"(the rise (L - a)^2/(2 edge_radius) must lie in [{rise[0]:g}, {rise[1]:g}]), "
-                "or change L.")
+        return (
+            f"Use {lo:.3g} <= edge_radius <= {hi:.3g} for a = {self.a:g} and L = {L:g} "
+            f"(the rise (L - a)^2/(2 edge_radius) must lie in [{rise[0]:g}, {rise[1]:g}]), "
+            "or change L."
+        )
 
 
 # --------------------------------------------------------------------------
@@ -233,9 +256,11 @@ class Shape:
 
     def __post_init__(self):
         if not callable(self.func):
-            raise SceneError(f"Shape func must be a callable func(x, y) on numpy arrays, got "
-                             f"{type(self.func).__name__}; in a scene file use kind = "
-                             "'heightmap' or an analytic kind instead.")
+            raise SceneError(
+                f"Shape func must be a callable func(x, y) on numpy arrays, got "
+                f"{type(self.func).__name__}; in a scene file use kind = "
+                "'heightmap' or an analytic kind instead."
+            )
         object.__setattr__(self, "symmetric_y", bool(self.symmetric_y))
         g = np.linspace(-1.0, 1.0, 5)
         X, Y = np.meshgrid(g, g, indexing="ij")
@@ -248,23 +273,28 @@ class Shape:
                 raise SceneError(
                     f"Shape {self.name!r} declares symmetric_y=True, but func(x, -y) != func(x, y): "
                     f"func({X[k]:.3g}, {Y[k]:.3g}) = {s[k]:.6g}, func({X[k]:.3g}, {-Y[k]:.3g}) = "
-                    f"{s_m[k]:.6g}. Pass symmetric_y=False (the solver then uses the full disk).")
+                    f"{s_m[k]:.6g}. Pass symmetric_y=False (the solver then uses the full disk)."
+                )
 
     def gap(self, x, y):
         """``func(x, y)`` checked: real, finite, same shape as the broadcast inputs."""
         x, y = _xy(x, y)
         try:
-            with np.errstate(all="ignore"):          # NaN / inf results are refused below
+            with np.errstate(all="ignore"):  # NaN / inf results are refused below
                 s = self.func(x.copy(), y.copy())
         except Exception as exc:  # noqa: BLE001 - the user's code: report what failed
-            raise SceneError(f"Shape {self.name!r}: func(x, y) raised {type(exc).__name__}: {exc}. "
-                             "It must accept numpy arrays (use np.sin, np.hypot, ...).") from None
+            raise SceneError(
+                f"Shape {self.name!r}: func(x, y) raised {type(exc).__name__}: {exc}. "
+                "It must accept numpy arrays (use np.sin, np.hypot, ...)."
+            ) from None
         s = check_shape_values(f"Shape {self.name!r}: func(x, y)", s, x.shape)
         if not np.all(np.isfinite(s)):
             bad = np.flatnonzero(~np.isfinite(s.ravel()))[0]
-            raise SceneError(f"Shape {self.name!r}: func(x, y) is not finite (NaN or inf) at "
-                             f"(x, y) = ({x.ravel()[bad]:.3g}, {y.ravel()[bad]:.3g}): fix the "
-                             "function so that it returns finite gaps over the whole domain.")
+            raise SceneError(
+                f"Shape {self.name!r}: func(x, y) is not finite (NaN or inf) at "
+                f"(x, y) = ({x.ravel()[bad]:.3g}, {y.ravel()[bad]:.3g}): fix the "
+                "function so that it returns finite gaps over the whole domain."
+            )
         return s
 
 
@@ -309,13 +339,17 @@ class HeightMap:
             except (TypeError, ValueError):
                 raise SceneError(f"HeightMap {name} must be a 1-D array of numbers.") from None
             if a.ndim != 1 or a.size < 2:
-                raise SceneError(f"HeightMap {name} must be a 1-D array of at least 2 grid "
-                                 f"coordinates, got shape {a.shape}.")
+                raise SceneError(
+                    f"HeightMap {name} must be a 1-D array of at least 2 grid "
+                    f"coordinates, got shape {a.shape}."
+                )
             if not np.all(np.isfinite(a)):
                 raise SceneError(f"HeightMap {name} contains NaN or inf: give finite grid coordinates.")
             if np.any(np.diff(a) <= 0):
-                raise SceneError(f"HeightMap {name} must be strictly increasing (monotonic grid): "
-                                 f"sort the axis and the matching axis of z.")
+                raise SceneError(
+                    f"HeightMap {name} must be strictly increasing (monotonic grid): "
+                    f"sort the axis and the matching axis of z."
+                )
             a.setflags(write=False)
             axes.append(a)
         x, y = axes
@@ -324,21 +358,27 @@ class HeightMap:
         except (TypeError, ValueError):
             raise SceneError("HeightMap z must be a 2-D array of numbers.") from None
         if z.shape != (x.size, y.size):
-            raise SceneError(f"HeightMap z has shape {z.shape} but the grid needs "
-                             f"(len(x), len(y)) = ({x.size}, {y.size}): z[i, j] = s(x[i], y[j]) "
-                             "(transpose z if it is indexed [y, x]).")
+            raise SceneError(
+                f"HeightMap z has shape {z.shape} but the grid needs "
+                f"(len(x), len(y)) = ({x.size}, {y.size}): z[i, j] = s(x[i], y[j]) "
+                "(transpose z if it is indexed [y, x])."
+            )
         if not np.all(np.isfinite(z)):
-            raise SceneError("HeightMap z contains NaN or inf values: fill the gaps in the map "
-                             "(e.g. by interpolation) before using it.")
+            raise SceneError(
+                "HeightMap z contains NaN or inf values: fill the gaps in the map "
+                "(e.g. by interpolation) before using it."
+            )
         z.setflags(write=False)
         sym = self.symmetric_y
         if sym is None:
             tol = 1e-12 * max(1.0, float(np.abs(z).max()))
-            sym = bool(np.allclose(y, -y[::-1], rtol=0.0, atol=1e-12 * max(1.0, abs(y).max()))
-                       and np.allclose(z, z[:, ::-1], rtol=0.0, atol=tol))
+            sym = bool(
+                np.allclose(y, -y[::-1], rtol=0.0, atol=1e-12 * max(1.0, abs(y).max()))
+                and np.allclose(z, z[:, ::-1], rtol=0.0, atol=tol)
+            )
         from scipy.interpolate import RegularGridInterpolator
-        interp = RegularGridInterpolator((x, y), z, method="linear", bounds_error=False,
-                                         fill_value=np.nan)
+
+        interp = RegularGridInterpolator((x, y), z, method="linear", bounds_error=False, fill_value=np.nan)
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "z", z)
@@ -346,9 +386,11 @@ class HeightMap:
         object.__setattr__(self, "_interp", interp)
 
     def __repr__(self):
-        return (f"HeightMap(x=[{self.x[0]:g} .. {self.x[-1]:g}] ({self.x.size}), "
-                f"y=[{self.y[0]:g} .. {self.y[-1]:g}] ({self.y.size}), "
-                f"z=[{self.z.min():g} .. {self.z.max():g}], symmetric_y={self.symmetric_y})")
+        return (
+            f"HeightMap(x=[{self.x[0]:g} .. {self.x[-1]:g}] ({self.x.size}), "
+            f"y=[{self.y[0]:g} .. {self.y[-1]:g}] ({self.y.size}), "
+            f"z=[{self.z.min():g} .. {self.z.max():g}], symmetric_y={self.symmetric_y})"
+        )
 
     @classmethod
     def from_file(cls, path, symmetric_y: bool | None = None) -> HeightMap:
@@ -358,15 +400,21 @@ class HeightMap:
             with np.load(path) as data:
                 missing = {"x", "y", "z"} - set(data.files)
                 if missing:
-                    raise SceneError(f"height map file {str(path)!r} lacks arrays {sorted(missing)}; "
-                                     "save it with np.savez(path, x=x, y=y, z=z).")
+                    raise SceneError(
+                        f"height map file {str(path)!r} lacks arrays {sorted(missing)}; "
+                        "save it with np.savez(path, x=x, y=y, z=z)."
+                    )
                 x, y, z = data["x"], data["y"], data["z"]
         except FileNotFoundError:
-            raise SceneError(f"height map file {str(path)!r} does not exist: check the path "
-                             "(relative paths are relative to the scene file).") from None
+            raise SceneError(
+                f"height map file {str(path)!r} does not exist: check the path "
+                "(relative paths are relative to the scene file)."
+            ) from None
         except (OSError, ValueError) as exc:
-            raise SceneError(f"cannot read height map file {str(path)!r} ({exc}); save it with "
-                             "np.savez(path, x=x, y=y, z=z).") from None
+            raise SceneError(
+                f"cannot read height map file {str(path)!r} ({exc}); save it with "
+                "np.savez(path, x=x, y=y, z=z)."
+            ) from None
         return cls(x, y, z, symmetric_y)
 
     @property
@@ -381,7 +429,8 @@ class HeightMap:
             raise SceneError(
                 f"HeightMap grid [{self.x[0]:g}, {self.x[-1]:g}] x [{self.y[0]:g}, {self.y[-1]:g}] "
                 f"does not cover the domain r <= L = {L:g}: extend the map to |x|, |y| >= {L:g} "
-                f"or use a smaller domain radius L <= {ext:g}.")
+                f"or use a smaller domain radius L <= {ext:g}."
+            )
 
     def gap(self, x, y):
         """Bilinear interpolation of the map; SceneError for points outside the grid."""
@@ -400,7 +449,8 @@ class HeightMap:
             raise SceneError(
                 f"HeightMap asked for the gap at (x, y) = ({pts[bad, 0]:.3g}, {pts[bad, 1]:.3g}), "
                 f"outside its grid [{self.x[0]:g}, {self.x[-1]:g}] x [{self.y[0]:g}, {self.y[-1]:g}]: "
-                "extend the map to cover the whole domain r <= L.")
+                "extend the map to cover the whole domain r <= L."
+            )
         return s.reshape(x.shape)
 
 
@@ -434,9 +484,11 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     cls = INDENTERS[kind]
     units = getattr(cls, "si_units", None)
     if units is None:
-        raise SceneError(f"indenter kind {kind!r} cannot be given in SI units; use a normalized "
-                         f"scene (no [si] table) or one of "
-                         f"{sorted(k for k, c in INDENTERS.items() if hasattr(c, 'si_units'))}.")
+        raise SceneError(
+            f"indenter kind {kind!r} cannot be given in SI units; use a normalized "
+            f"scene (no [si] table) or one of "
+            f"{sorted(k for k, c in INDENTERS.items() if hasattr(c, 'si_units'))}."
+        )
     extra = set(params) - set(units)
     if extra:
         raise SceneError(f"indenter kind {kind!r} does not take {sorted(extra)}; it takes {sorted(units)}.")
@@ -445,4 +497,3 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     for k, v in params.items():
         out[k] = _positive(f"{kind} {k} [m]", v) / scale[units[k]]
     return cls(**out)
-

@@ -44,8 +44,8 @@ def _edge_term(ax, ay, bx, by, cx, cy):
         ey = ey / le
         dbx = bx - ax
         dby = by - ay
-        h = dbx * ey - dby * ex                # signed distance of A from line BC
-        sb = dbx * ex + dby * ey               # positions along e from the foot of A
+        h = dbx * ey - dby * ex  # signed distance of A from line BC
+        sb = dbx * ex + dby * ey  # positions along e from the foot of A
         sc = (cx - ax) * ex + (cy - ay) * ey
         ah = np.abs(h)
         val = h * (np.arcsinh(sc / ah) - np.arcsinh(sb / ah))
@@ -220,7 +220,7 @@ def edge_terms(points, nodes, edges, out=None):
     rows = max(1, _BLOCK_BYTES // (8 * 6 * max(nE, nodes.shape[0])))
     for s in range(0, pts.shape[0], rows):
         sl = slice(s, min(s + rows, pts.shape[0]))
-        dx = nodes[None, :, 0] - pts[sl, 0:1]          # (rows, nn): vertex - A
+        dx = nodes[None, :, 0] - pts[sl, 0:1]  # (rows, nn): vertex - A
         dy = nodes[None, :, 1] - pts[sl, 1:2]
         rho = np.hypot(dx, dy)
         bx, by = dx[:, B], dy[:, B]

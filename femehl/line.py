@@ -57,18 +57,27 @@ alone.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from .errors import SceneError
-from .scene import (Constant, Fluid, Motion, RampHold, SceneEffects, Table, TanhStart,
-                    _as_time_function, check_finite, check_positive)
-from .stepping import State
+from .scene import (
+    Constant,
+    Fluid,
+    Motion,
+    RampHold,
+    SceneEffects,
+    Table,
+    TanhStart,
+    _as_time_function,
+    check_finite,
+    check_positive,
+)
 from .substrates import Winkler
 
-__all__ = ["LineScene", "line_nodes", "solve_line"]
+__all__ = ["LineScene", "line_nodes"]
 
 
 def _default_motion() -> Motion:
@@ -98,6 +107,8 @@ class LineScene(SceneEffects):
         instead.  ``motion.load`` is accepted too (and moved here); give one of them.
     """
 
+    default_method = "line"
+
     k: float = 1.0
     beta: float = 10.0
     motion: Motion = field(default_factory=_default_motion)
@@ -105,39 +116,51 @@ class LineScene(SceneEffects):
     load: Callable[[float], float] | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "k", check_positive(
-            "Winkler stiffness k", self.k, "Use a large k for a nearly rigid substrate."))
-        object.__setattr__(self, "beta", check_positive(
-            "beta", self.beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation."))
-        object.__setattr__(self, "L", check_positive(
-            "domain half length L", self.L, "The domain is [-L, L]; L = 2 suits hc >= -0.5."))
+        object.__setattr__(
+            self,
+            "k",
+            check_positive("Winkler stiffness k", self.k, "Use a large k for a nearly rigid substrate."),
+        )
+        object.__setattr__(
+            self,
+            "beta",
+            check_positive("beta", self.beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation."),
+        )
+        object.__setattr__(
+            self,
+            "L",
+            check_positive("domain half length L", self.L, "The domain is [-L, L]; L = 2 suits hc >= -0.5."),
+        )
         if not isinstance(self.motion, Motion):
             raise SceneError(
                 f"LineScene.motion must be a femehl.scene.Motion, got {type(self.motion).__name__}: "
-                "wrap the gap and velocity as Motion(gap=..., velocity=...).")
+                "wrap the gap and velocity as Motion(gap=..., velocity=...)."
+            )
         mload = getattr(self.motion, "load", None)
         if mload is not None:
             if self.load is not None:
-                raise SceneError(
-                    "the load is imposed twice (LineScene.load and Motion.load): give only one.")
+                raise SceneError("the load is imposed twice (LineScene.load and Motion.load): give only one.")
             object.__setattr__(self, "load", mload)
         if self.load is not None:
             object.__setattr__(self, "load", _as_time_function("LineScene load F(t)", self.load))
             check_finite("load F(t=0)", self.load(0.0), "The load history must return finite values.")
-            object.__setattr__(self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity,
-                                                      load=self.load))
+            object.__setattr__(
+                self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity, load=self.load)
+            )
         hc0 = self.motion.hc(0.0)
         if hc0 <= 0.0:
             raise SceneError(
                 f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
                 "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
-                "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0).")
+                "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
+            )
         a = self.contact_halfwidth()
         if a is not None and self.L < 1.5 * a:
             raise SceneError(
                 f"domain half length L = {self.L:g} is too small to hold the contact: the dry "
                 f"Winkler contact of this run reaches |x| = {a:.3g}, and the pressure must decay "
-                f"before x = +-L. Use L >= {1.5 * a:.3g}.")
+                f"before x = +-L. Use L >= {1.5 * a:.3g}."
+            )
 
     @property
     def fluid(self) -> Fluid:
@@ -221,14 +244,16 @@ def line_nodes(L: float, n_elements: int, grading="uniform", fine: float | None 
     n = int(n_elements)
     if isinstance(grading, str):
         if grading != "uniform":
-            raise SceneError(f"grading must be 'uniform', a size ratio >= 1 or a density "
-                             f"function, got {grading!r}.")
+            raise SceneError(
+                f"grading must be 'uniform', a size ratio >= 1 or a density function, got {grading!r}."
+            )
         return np.linspace(-L, L, n + 1)
     if callable(grading):
         rho = grading
     else:
-        r = check_finite("grading (size ratio)", grading,
-                         "Give 'uniform', a ratio >= 1 or a density function rho(x).")
+        r = check_finite(
+            "grading (size ratio)", grading, "Give 'uniform', a ratio >= 1 or a density function rho(x)."
+        )
         if r < 1.0:
             raise SceneError(f"grading ratio must be >= 1 (fine/coarse element size), got {r:g}.")
         xf = 0.5 * L if fine is None else check_positive("fine zone half width", fine)
@@ -237,6 +262,7 @@ def line_nodes(L: float, n_elements: int, grading="uniform", fine: float | None 
         def rho(x):
             u = np.clip((np.abs(x) - xf) / width, 0.0, 1.0)
             return r + (1.0 - r) * u
+
     xs = np.linspace(-L, L, 200 * n + 1)
     try:
         dens = np.asarray(rho(xs), dtype=float) * np.ones_like(xs)
@@ -248,21 +274,3 @@ def line_nodes(L: float, n_elements: int, grading="uniform", fine: float | None 
     x = np.interp(np.linspace(0.0, cum[-1], n + 1), cum, xs)
     x[0], x[-1] = -L, L
     return x
-
-
-# --------------------------------------------------------------------------
-# running: line contact is the registered method "line" of the one core
-# --------------------------------------------------------------------------
-def solve_line(scene: LineScene, t_end: float, dt: float, *, store_every: int = 1,
-               callback: Callable[[State], None] | None = None, **opts):
-    """Run a line-contact scene: ``femehl.solve(scene, method="line", ...)``.
-
-    ``opts`` are the discretization's (``n_elements``, ``grading``, ``fine``, see
-    :class:`femehl.discretizations.fe_line.LineDisc`) and the stepper's (``scheme``).
-    Returns a :class:`femehl.result.Result`; its ``disc.x`` / ``disc.xc`` are the nodes
-    (where ``State.p`` lives) and the element centroids (``State.d``, ``State.w``).
-    """
-    from .api import solve
-
-    return solve(scene, method="line", t_end=t_end, dt=dt, store_every=store_every,
-                 callback=callback, **opts)

@@ -94,15 +94,23 @@ def _shoot(k, beta, hc, L, V, d_star, method, rtol, dense=False):
 
     def f(x, y):
         d = y[0]
-        return [x - c * (d - d_star) / d ** 3, k * (d - hc - 0.5 * x * x)]
+        return [x - c * (d - d_star) / d**3, k * (d - hc - 0.5 * x * x)]
 
     def jac(x, y):
         d = y[0]
-        return [[-c * (3.0 * d_star - 2.0 * d) / d ** 4, 0.0], [k, 0.0]]
+        return [[-c * (3.0 * d_star - 2.0 * d) / d**4, 0.0], [k, 0.0]]
 
     d0 = hc + 0.5 * L * L
-    return solve_ivp(f, (-L, L), [d0, 0.0], method=method, jac=jac, rtol=rtol,
-                     atol=rtol * 1e-2 * min(1.0, d0), dense_output=dense)
+    return solve_ivp(
+        f,
+        (-L, L),
+        [d0, 0.0],
+        method=method,
+        jac=jac,
+        rtol=rtol,
+        atol=rtol * 1e-2 * min(1.0, d0),
+        dense_output=dense,
+    )
 
 
 def _solve(k, beta, hc, L, V, method, rtol, guess=None) -> SteadyLine:
@@ -130,11 +138,21 @@ def _solve(k, beta, hc, L, V, method, rtol, guess=None) -> SteadyLine:
     if not (mlo < 0.0 < mhi):
         raise SolverError(
             f"steady_line: cannot bracket d_* in ({lo:.3g}, {hi:.3g}) (misses {mlo:.3g}, {mhi:.3g}); "
-            "check hc and L (the film hc + x^2/2 must open toward the ends).")
+            "check hc and L (the film hc + x^2/2 must open toward the ends)."
+        )
     ds = brentq(miss, lo, hi, xtol=1e-15 * d0, rtol=4e-15, maxiter=200)
     sol = _shoot(k, beta, hc, L, V, ds, method, rtol, dense=True)
-    return SteadyLine(k=k, beta=beta, hc=hc, L=L, V=V, d_star=float(ds), load=float(sol.y[1, -1]),
-                      end_error=float(sol.y[0, -1] - d0), _sol=sol)
+    return SteadyLine(
+        k=k,
+        beta=beta,
+        hc=hc,
+        L=L,
+        V=V,
+        d_star=float(ds),
+        load=float(sol.y[1, -1]),
+        end_error=float(sol.y[0, -1] - d0),
+        _sol=sol,
+    )
 
 
 def _check(k, beta, hc, L, V, method):
@@ -142,18 +160,31 @@ def _check(k, beta, hc, L, V, method):
     beta = check_positive("beta", beta)
     hc = check_finite("hc", hc)
     L = check_positive("domain half length L", L)
-    V = check_positive("sliding velocity V", V,
-                       "For V = 0 the steady film is flat: there is no sliding solution.")
+    V = check_positive(
+        "sliding velocity V", V, "For V = 0 the steady film is flat: there is no sliding solution."
+    )
     if hc + 0.5 * L * L <= 0.0:
-        raise SceneError(f"hc + L^2/2 = {hc + 0.5 * L * L:g} <= 0: the film is closed at the ends; "
-                         "use a larger L.")
+        raise SceneError(
+            f"hc + L^2/2 = {hc + 0.5 * L * L:g} <= 0: the film is closed at the ends; use a larger L."
+        )
     if method not in ("LSODA", "Radau", "BDF"):
         raise SceneError(f"method must be 'LSODA', 'Radau' or 'BDF', got {method!r}.")
     return k, beta, hc, L, V
 
 
-def steady_line(k: float, beta: float, hc: float, L: float, V: float = 1.0, *, x=None,
-                n: int = 2001, method: str = "LSODA", rtol: float = 1e-12, full: bool = False):
+def steady_line(
+    k: float,
+    beta: float,
+    hc: float,
+    L: float,
+    V: float = 1.0,
+    *,
+    x=None,
+    n: int = 2001,
+    method: str = "LSODA",
+    rtol: float = 1e-12,
+    full: bool = False,
+):
     """Steady sliding of a cylinder at fixed clearance ``hc``: shoot on ``d_*``.
 
     Parameters
@@ -188,8 +219,17 @@ def steady_line(k: float, beta: float, hc: float, L: float, V: float = 1.0, *, x
     return xs, sl.film(xs), sl.pressure(xs), sl.d_star
 
 
-def steady_line_load(k: float, beta: float, F: float, L: float, V: float = 1.0, *,
-                     hc_bracket=None, method: str = "LSODA", rtol: float = 1e-12) -> SteadyLine:
+def steady_line_load(
+    k: float,
+    beta: float,
+    F: float,
+    L: float,
+    V: float = 1.0,
+    *,
+    hc_bracket=None,
+    method: str = "LSODA",
+    rtol: float = 1e-12,
+) -> SteadyLine:
     """Steady sliding under an imposed load per unit length ``F``: find hc by brentq.
 
     The load of :func:`steady_line` decreases monotonically as hc grows; the
@@ -211,8 +251,10 @@ def steady_line_load(k: float, beta: float, F: float, L: float, V: float = 1.0, 
 
     glo, ghi = g(lo), g(hi)
     if not (glo > 0.0 > ghi):
-        raise SolverError(f"steady_line_load: F = {F:g} is not bracketed by hc in ({lo:g}, {hi:g}) "
-                          f"(load - F = {glo:.3g}, {ghi:.3g}); pass hc_bracket.")
+        raise SolverError(
+            f"steady_line_load: F = {F:g} is not bracketed by hc in ({lo:g}, {hi:g}) "
+            f"(load - F = {glo:.3g}, {ghi:.3g}); pass hc_bracket."
+        )
     # the load is computed to about rtol, so hc is not worth more digits than that
     hc = brentq(g, lo, hi, xtol=max(1e-13, 10 * rtol), rtol=1e-13)
     return last[hc] if hc in last else _solve(k, beta, hc, L, V, method, rtol, guess=last["d_star"])

@@ -9,6 +9,7 @@ between the two stored states around the requested time.
 
 from __future__ import annotations
 
+import pathlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -175,12 +176,17 @@ class Result:
         t = float(t)
         tol = 1e-9 * max(1.0, abs(ts[-1]))
         if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
-            raise SceneError(f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}]: give a time "
-                             "the run reached.")
+            raise SceneError(
+                f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}]: give a time the run reached."
+            )
         return float(np.interp(t, ts, getattr(self, name)))
 
-    def save(self, folder) -> "pathlib.Path":  # noqa: F821
-        """Write the summary CSV, centreline PNG and field series to ``folder``."""
+    def save(self, folder, *, overwrite: bool = False) -> pathlib.Path:
+        """Write the summary CSV, the field series and the PNGs to ``folder``.
+
+        A folder that already holds a run is refused unless ``overwrite=True`` (which
+        replaces femehl's files of that run only; other files stay).
+        """
         from .output import write_all
 
-        return write_all(self, folder)
+        return write_all(self, folder, overwrite=overwrite)

@@ -43,6 +43,7 @@ def _reporter(log):
         logger.info(message)
         if log is not None:
             log(message)
+
     return say
 
 
@@ -50,21 +51,27 @@ def _check_resume_time(start, t_end: float, dt: float) -> None:
     """The checkpoint's time is on the run's time grid and not past ``t_end``."""
     k = round(start.t / dt)
     if abs(k * dt - start.t) > 1e-9 * max(1.0, start.t):
-        raise SceneError(f"cannot resume at t = {start.t:g} with dt = {dt:g}: "
-                         "resume with the dt of the original run.")
+        raise SceneError(
+            f"cannot resume at t = {start.t:g} with dt = {dt:g}: resume with the dt of the original run."
+        )
     if t_end < start.t - 1e-9 * max(1.0, start.t):
-        raise SceneError(f"t_end = {t_end:g} is before the checkpoint at t = {start.t:g}: "
-                         f"give t_end >= {start.t:g} to resume.")
+        raise SceneError(
+            f"t_end = {t_end:g} is before the checkpoint at t = {start.t:g}: "
+            f"give t_end >= {start.t:g} to resume."
+        )
 
 
 def _terms(scene, stepper, t_end: float) -> str:
     eff = scene.effects(t_end)
     info = getattr(stepper, "info", {}) or {}
-    return (f"femehl: method {stepper.method}, terms: squeeze={eff['squeeze']}, "
-            f"sliding={eff['sliding']}, elasticity={eff['elasticity']}, "
-            f"imposed_load={eff['imposed_load']}; "
-            + ", ".join(f"{k}={v}" for k, v in info.items()
-                        if k in ("mesh", "elements", "nodes", "unknowns", "half")))
+    return (
+        f"femehl: method {stepper.method}, terms: squeeze={eff['squeeze']}, "
+        f"sliding={eff['sliding']}, elasticity={eff['elasticity']}, "
+        f"imposed_load={eff['imposed_load']}; "
+        + ", ".join(
+            f"{k}={v}" for k, v in info.items() if k in ("mesh", "elements", "nodes", "unknowns", "half")
+        )
+    )
 
 
 def _pictures(result: Result, folder: pathlib.Path) -> None:
@@ -73,13 +80,25 @@ def _pictures(result: Result, folder: pathlib.Path) -> None:
         return
     try:
         draw_figures(result, folder)
-    except Exception as exc:           # noqa: BLE001 - pictures are a convenience
+    except Exception as exc:  # noqa: BLE001 - pictures are a convenience
         logger.warning("femehl: could not draw the PNGs in %s (%s: %s)", folder, type(exc).__name__, exc)
 
 
-def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every=10,
-                  progress=False, log=None, checkpoint_every=None, resume=False, overwrite=False,
-                  **options) -> Result:
+def run_to_folder(
+    scene,
+    folder,
+    *,
+    method=None,
+    t_end=5.0,
+    dt=0.01,
+    store_every=10,
+    progress=False,
+    log=None,
+    checkpoint_every=None,
+    resume=False,
+    overwrite=False,
+    **options,
+) -> Result:
     """Solve ``scene`` and write ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs.
 
     Parameters
@@ -137,8 +156,10 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
     if resume:
         say(f"femehl: resuming from the checkpoint at t = {start.t:g} (step {start.step})")
         if t_end <= start.t + 1e-9 * max(1.0, start.t):
-            say(f"femehl: the run in {folder} is already at t_end = {t_end:g}: nothing to do "
-                "(give a larger t_end to go on)")
+            say(
+                f"femehl: the run in {folder} is already at t_end = {t_end:g}: nothing to do "
+                "(give a larger t_end to go on)"
+            )
         writer = checkpoint.resume_writer(folder, stepper.disc, store_every, start.t)
     else:
         writer = RunWriter(folder, stepper.disc, every=store_every)
@@ -146,6 +167,7 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
     bar = None
     if progress:
         from tqdm import tqdm
+
         done = 0 if start is None else round(start.t / dt)
         bar = tqdm(total=nsteps, initial=done, unit="step", desc=f"femehl {stepper.method}", leave=True)
     last = {"state": None, "saved": None}
@@ -158,13 +180,16 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
                 checkpoint.save_checkpoint(folder, state)
                 last["saved"] = state
         except OSError as exc:
-            raise OutputError(f"cannot write into {str(folder)!r} at t = {state.t:g} "
-                              f"({exc.strerror or exc}): free space or fix permissions, then resume "
-                              "(resume=True, --resume).") from exc
+            raise OutputError(
+                f"cannot write into {str(folder)!r} at t = {state.t:g} "
+                f"({exc.strerror or exc}): free space or fix permissions, then resume "
+                "(resume=True, --resume)."
+            ) from exc
         if bar is not None and state.step:
             bar.update(1)
-            bar.set_postfix(t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}",
-                            refresh=False)
+            bar.set_postfix(
+                t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}", refresh=False
+            )
 
     result = None
     finished = False
@@ -182,14 +207,13 @@ def run_to_folder(scene, folder, *, method=None, t_end=5.0, dt=0.01, store_every
     finally:
         if bar is not None:
             bar.close()
-        writer.close()                                   # the last state's fields, CSV closed
+        writer.close()  # the last state's fields, CSV closed
         state = last["state"]
         if state is not None and state is not last["saved"]:
-            checkpoint.save_checkpoint(folder, state)    # the last good state
+            checkpoint.save_checkpoint(folder, state)  # the last good state
         if result is not None:
             result.info["wall_s"] = time.perf_counter() - t0
             _pictures(result, folder)
         if state is not None and not finished:
-            say(f"femehl: output up to t = {state.t:g} is in {folder}; the checkpoint is at "
-                f"t = {state.t:g}")
+            say(f"femehl: output up to t = {state.t:g} is in {folder}; the checkpoint is at t = {state.t:g}")
     return result

@@ -38,8 +38,8 @@ from typing import ClassVar, Protocol, runtime_checkable
 import numpy as np
 
 from .errors import SceneError
-from .substrates import HalfSpace, Rigid, Winkler  # noqa: F401  (re-exported)
 from .indenters import Sphere  # indenters live in femehl.indenters; Sphere stays importable here
+from .substrates import HalfSpace, Rigid, Winkler  # noqa: F401  (re-exported)
 
 # the validators live in femehl.validation; re-exported here (other modules import them from scene)
 from .validation import _short, call_time_function, check_finite, check_positive, check_shape_values
@@ -123,13 +123,11 @@ class Table:
         if t.size == 0:
             raise SceneError("Table is empty: give at least one (time, value) pair.")
         if t.size != v.size:
-            raise SceneError(
-                f"Table has {t.size} times but {v.size} values: give one value per time.")
+            raise SceneError(f"Table has {t.size} times but {v.size} values: give one value per time.")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
             raise SceneError("Table times and values must be finite (no NaN or inf).")
         if np.any(np.diff(t) <= 0):
-            raise SceneError(
-                "Table times must be strictly increasing: sort the rows and remove duplicates.")
+            raise SceneError("Table times must be strictly increasing: sort the rows and remove duplicates.")
         object.__setattr__(self, "times", tuple(t.tolist()))
         object.__setattr__(self, "values", tuple(v.tolist()))
 
@@ -210,8 +208,15 @@ class Fluid:
     beta: float = 200.0
 
     def __post_init__(self):
-        object.__setattr__(self, "beta", check_positive("beta", self.beta,
-                       "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it."))
+        object.__setattr__(
+            self,
+            "beta",
+            check_positive(
+                "beta",
+                self.beta,
+                "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it.",
+            ),
+        )
 
 
 @dataclass(frozen=True)
@@ -248,25 +253,34 @@ class Motion:
 
     def F(self, t: float) -> float:
         """The imposed load F(t) (finite, >= 0: the lubricated contact cannot pull)."""
-        F = call_time_function("the load history F(t)", "F", self.load, t,
-                               "The load history must return finite values.")
+        F = call_time_function(
+            "the load history F(t)", "F", self.load, t, "The load history must return finite values."
+        )
         if F < 0.0:
             raise SceneError(_negative_load_message(F, t))
         return F
 
     def hc(self, t: float) -> float:
-        return call_time_function("the gap history hc(t)", "hc", self.gap, t,
-                                  "The gap history must return finite values.")
+        return call_time_function(
+            "the gap history hc(t)", "hc", self.gap, t, "The gap history must return finite values."
+        )
 
     def V(self, t: float) -> float:
-        return call_time_function("the velocity history V(t)", "V", self.velocity, t,
-                                  "The velocity history must return finite values.")
+        return call_time_function(
+            "the velocity history V(t)",
+            "V",
+            self.velocity,
+            t,
+            "The velocity history must return finite values.",
+        )
 
 
 def _negative_load_message(F: float, t: float) -> str:
-    return (f"the imposed load F(t={t:g}) = {F:g} is negative: the lubricated model cannot pull "
-            "the indenter (the film would be in tension, i.e. cavitate). Give a load history "
-            "with F(t) >= 0 at all times, or impose the gap hc(t) instead (Motion(gap=...)).")
+    return (
+        f"the imposed load F(t={t:g}) = {F:g} is negative: the lubricated model cannot pull "
+        "the indenter (the film would be in tension, i.e. cavitate). Give a load history "
+        "with F(t) >= 0 at all times, or impose the gap hc(t) instead (Motion(gap=...))."
+    )
 
 
 @dataclass(frozen=True)
@@ -280,7 +294,12 @@ class Domain:
 
 
 class SceneEffects:
-    """What a scene calls for over a run: shared by :class:`Scene` and ``LineScene``."""
+    """What a scene calls for over a run: shared by :class:`Scene` and ``LineScene``.
+
+    ``default_method`` is the method ``femehl.solve`` uses when none is given.
+    """
+
+    default_method = "fe"
 
     def has_sliding(self, t_end: float, n: int = 2001) -> bool:
         ts = np.linspace(0.0, t_end, n)
@@ -316,17 +335,19 @@ class Scene(SceneEffects):
     def __post_init__(self):
         for name, cls in (("fluid", Fluid), ("motion", Motion), ("domain", Domain)):
             if not isinstance(getattr(self, name), cls):
-                raise SceneError(f"Scene.{name} must be a {cls.__name__}, got "
-                                 f"{type(getattr(self, name)).__name__}.")
+                raise SceneError(
+                    f"Scene.{name} must be a {cls.__name__}, got {type(getattr(self, name)).__name__}."
+                )
         if not hasattr(self.indenter, "gap"):
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
         hc0 = self.motion.hc(0.0)
-        self.motion.V(0.0)               # a velocity history that fails at t = 0 is refused now
+        self.motion.V(0.0)  # a velocity history that fails at t = 0 is refused now
         if hc0 <= 0.0:
             raise SceneError(
                 f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
                 "film thickness d = hc + s would be <= 0 at the tip. Start with a positive gap "
-                "(the paper case uses h0 = +0.1).")
+                "(the paper case uses h0 = +0.1)."
+            )
         self._check_domain_holds_contact()
 
     def _check_domain_holds_contact(self):
@@ -364,12 +385,11 @@ class Scene(SceneEffects):
         extent = float(getattr(ind, "extent", math.inf))
         rmax = min(1.5 * L, max(extent, L))
         nr, nth = 401, 96
-        r = np.union1d(np.linspace(0.0, rmax, nr), [L])              # r = L is a sample
+        r = np.union1d(np.linspace(0.0, rmax, nr), [L])  # r = L is a sample
         nr = r.size
         half = bool(getattr(ind, "symmetric_y", False))
-        th = np.linspace(0.0, math.pi if half else 2.0 * math.pi, nth + 1 if half else nth,
-                         endpoint=half)
-        TH, RR = np.meshgrid(th, r, indexing="ij")                  # (nth, nr)
+        th = np.linspace(0.0, math.pi if half else 2.0 * math.pi, nth + 1 if half else nth, endpoint=half)
+        TH, RR = np.meshgrid(th, r, indexing="ij")  # (nth, nr)
         X, Y = RR * np.cos(TH), RR * np.sin(TH)
         inside = RR <= L
         s_in = self._sample_gap(X[inside], Y[inside])
@@ -393,18 +413,19 @@ class Scene(SceneEffects):
             raise SceneError(
                 f"the initial film hc(0) + s(x, y) reaches {dmin:.3g} <= 0 on the domain: the "
                 f"indenter's gap has a minimum {float(s_in.min()):.3g} below its tip. Shift the "
-                "shape so that s >= 0 with s(0, 0) = 0, or start with a larger gap hc(0).")
+                "shape so that s >= 0 with s(0, 0) = 0, or start with a larger gap hc(0)."
+            )
 
         def a_geo(depth):
             """Largest radius where -depth + s < 0 (rays interpolated linearly)."""
-            g = S - depth                                            # < 0: overlap
+            g = S - depth  # < 0: overlap
             neg = g < 0.0
             if not neg.any():
                 return 0.0
             rows = np.flatnonzero(neg.any(axis=1))
-            last = nr - 1 - np.argmax(neg[rows, ::-1], axis=1)       # last negative sample
+            last = nr - 1 - np.argmax(neg[rows, ::-1], axis=1)  # last negative sample
             if np.any(last == nr - 1):
-                return math.inf                                      # beyond the sampled disk
+                return math.inf  # beyond the sampled disk
             g0, g1 = g[rows, last], g[rows, last + 1]
             with np.errstate(all="ignore"):
                 frac = np.where(np.isfinite(g1), g0 / (g0 - g1), 1.0)
@@ -415,34 +436,39 @@ class Scene(SceneEffects):
             Fs = []
             for t in times:
                 try:
-                    Ft = call_time_function("the load history F(t)", "F", self.motion.load, t,
-                                            "The load history must return finite values.")
+                    Ft = call_time_function(
+                        "the load history F(t)",
+                        "F",
+                        self.motion.load,
+                        t,
+                        "The load history must return finite values.",
+                    )
                 except SceneError:
                     if t == 0.0:
                         raise
-                    continue                 # the run reports a failing load when it gets there
+                    continue  # the run reports a failing load when it gets there
                 if Ft < 0.0:
                     raise SceneError(_negative_load_message(Ft, t))
                 Fs.append(Ft)
             F = max(Fs, default=0.0)
             kind = getattr(self.substrate, "kind", "halfspace")
             if F == 0.0 or kind == "rigid":
-                return                       # a rigid substrate is never indented
+                return  # a rigid substrate is never indented
             if kind == "winkler":
                 k = float(self.substrate.k)
-                wr = np.gradient(r) * r                              # r dr (trapezoid-like)
+                wr = np.gradient(r) * r  # r dr (trapezoid-like)
                 wth = (math.pi if half else 2.0 * math.pi) / (th.size - (1 if half else 0))
                 wt = np.full(th.size, wth)
                 if half:
                     wt[[0, -1]] *= 0.5
-                    wt *= 2.0                                        # mirror half
+                    wt *= 2.0  # mirror half
 
-                def F_est(depth):        # dry Winkler contact: F = k int (depth - s)+ dA
+                def F_est(depth):  # dry Winkler contact: F = k int (depth - s)+ dA
                     return k * float(wt @ np.maximum(depth - S, 0.0) @ wr)
             else:
                 c = float(getattr(self.substrate, "compliance", 1.0))
 
-                def F_est(depth):        # Hertz law of the equivalent sphere
+                def F_est(depth):  # Hertz law of the equivalent sphere
                     return (4.0 / (3.0 * math.pi)) * a_geo(depth) * depth / (math.sqrt(2.0) * c)
 
             lo, hi = 0.0, 1.0
@@ -456,8 +482,10 @@ class Scene(SceneEffects):
                     hi = mid
             depth = hi
             a = a_geo(depth)
-            what = (f"the largest imposed load |F| = {F:g} (sampled over t in [0, {times[-1]:g}]) "
-                    f"presses the indenter about {depth:.3g} deep (dry-contact estimate)")
+            what = (
+                f"the largest imposed load |F| = {F:g} (sampled over t in [0, {times[-1]:g}]) "
+                f"presses the indenter about {depth:.3g} deep (dry-contact estimate)"
+            )
         else:
             hs = []
             for t in times:
@@ -479,7 +507,8 @@ class Scene(SceneEffects):
                 f"overlaps the rigid shape out to r = {a_txt} (a contact of radius about "
                 f"{a / math.sqrt(2.0):.3g} for a sphere), and the pressure must decay before "
                 f"r = L. Use L >= {need_txt} (the paper uses L = 2a)"
-                + (", and extend the height map to cover it." if math.isfinite(extent) else "."))
+                + (", and extend the height map to cover it." if math.isfinite(extent) else ".")
+            )
 
     def _describe_indenter(self) -> str:
         name = getattr(self.indenter, "name", None)
@@ -497,8 +526,10 @@ class Scene(SceneEffects):
         except SceneError:
             raise
         except Exception as exc:  # noqa: BLE001 - the user's shape: name the failure
-            raise SceneError(f"the indenter's gap(x, y) failed on the domain r <= {L:g} "
-                             f"({type(exc).__name__}: {exc}); fix the shape function.") from None
+            raise SceneError(
+                f"the indenter's gap(x, y) failed on the domain r <= {L:g} "
+                f"({type(exc).__name__}: {exc}); fix the shape function."
+            ) from None
         s = check_shape_values(what, raw, x.shape, "Fix the shape function.")
         bad = ~np.isfinite(s)
         if bad.any():
@@ -506,19 +537,23 @@ class Scene(SceneEffects):
             if np.isinf(s[k]) and callable(getattr(self.indenter, "domain_hint", None)):
                 raise SceneError(
                     f"{self._describe_indenter()} is too sharp for the domain r <= {L:g}: its gap "
-                    f"overflows to inf at (x, y) = ({x[k]:.3g}, {y[k]:.3g}). {self._rise_hint()}")
-            cause = ("overflows to inf" if np.isinf(s[k]) else "is NaN")
+                    f"overflows to inf at (x, y) = ({x[k]:.3g}, {y[k]:.3g}). {self._rise_hint()}"
+                )
+            cause = "overflows to inf" if np.isinf(s[k]) else "is NaN"
             raise SceneError(
                 f"{what} {cause} at (x, y) = ({x[k]:.3g}, {y[k]:.3g}): it must return one finite value "
-                f"per point. {self._rise_hint()}")
+                f"per point. {self._rise_hint()}"
+            )
         return s
 
     def _rise_hint(self) -> str:
         hint = getattr(self.indenter, "domain_hint", None)
         if callable(hint):
             return hint(self.domain.L, GAP_RISE)
-        return (f"Rescale the shape so that its rise across the domain lies in "
-                f"[{GAP_RISE[0]:g}, {GAP_RISE[1]:g}] (units of h_inf), or fix the shape function.")
+        return (
+            f"Rescale the shape so that its rise across the domain lies in "
+            f"[{GAP_RISE[0]:g}, {GAP_RISE[1]:g}] (units of h_inf), or fix the shape function."
+        )
 
     def _check_gap_rise(self, s) -> None:
         """An analytic indenter's gap must rise by GAP_RISE[0] .. GAP_RISE[1] across the domain.
@@ -532,7 +567,7 @@ class Scene(SceneEffects):
         the film d^3 spans more than 18 decades.
         """
         if not callable(getattr(self.indenter, "domain_hint", None)):
-            return       # a height map or user shape is taken as given (it may be a flat plate)
+            return  # a height map or user shape is taken as given (it may be a flat plate)
         L = self.domain.L
         rise = float(np.max(s) - np.min(s))
         lo, hi = GAP_RISE
@@ -540,12 +575,14 @@ class Scene(SceneEffects):
             raise SceneError(
                 f"{self._describe_indenter()} is flat on the domain r <= {L:g}: its gap rises only "
                 f"{rise:.3g} (units of h_inf, less than {lo:g}), so the domain holds no contact "
-                f"edge and the pressure cannot decay before r = L. {self._rise_hint()}")
+                f"edge and the pressure cannot decay before r = L. {self._rise_hint()}"
+            )
         if rise > hi:
             raise SceneError(
                 f"{self._describe_indenter()} is too sharp for the domain r <= {L:g}: its gap rises "
                 f"to {rise:.3g} (units of h_inf, more than {hi:g}), so the contact is a dot far "
-                f"smaller than any mesh of the domain. {self._rise_hint()}")
+                f"smaller than any mesh of the domain. {self._rise_hint()}"
+            )
 
     def _check_symmetric_y(self, x, y, s) -> None:
         """An indenter that declares symmetric_y must have s(x, -y) = s(x, y) on the domain."""
@@ -558,7 +595,8 @@ class Scene(SceneEffects):
                 f"{self._describe_indenter()} declares symmetric_y=True, but its gap is not "
                 f"symmetric in y on the domain r <= {self.domain.L:g}: s({x[k]:.3g}, {y[k]:.3g}) = "
                 f"{s[k]:.6g} but s({x[k]:.3g}, {-y[k]:.3g}) = {s_m[k]:.6g}. Pass symmetric_y=False "
-                "(the solver then uses the full disk), or make the shape symmetric.")
+                "(the solver then uses the full disk), or make the shape symmetric."
+            )
 
     def _check_times(self):
         """Times at which the gap / load histories are sampled by the domain check."""
@@ -574,7 +612,6 @@ class Scene(SceneEffects):
         extra = [t for t in extra if math.isfinite(t) and t >= 0.0]
         t_hi = max([t_hi] + extra)
         return np.unique(np.concatenate([np.linspace(0.0, t_hi, 1001), extra]))
-
 
 
 # --------------------------------------------------------------------------
@@ -615,7 +652,7 @@ class Dimensional:
     @property
     def beta(self) -> float:
         """beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss)   (Eq. 10e)."""
-        return (2.0 / 3.0) * (self.h_inf ** 2 / self.R) * math.pi * self.G / (self.eta * self.V_ss)
+        return (2.0 / 3.0) * (self.h_inf**2 / self.R) * math.pi * self.G / (self.eta * self.V_ss)
 
     @property
     def length(self) -> float:
@@ -640,7 +677,7 @@ class Dimensional:
     @property
     def force(self) -> float:
         """Load scale = pressure * length^2 [N]."""
-        return self.pressure * self.length ** 2
+        return self.pressure * self.length**2
 
     @property
     def velocity(self) -> float:
@@ -651,8 +688,7 @@ class Dimensional:
 
         ``quantity`` is one of length, height, time, pressure, force, velocity.
         """
-        scales = {q: getattr(self, q) for q in
-                  ("length", "height", "time", "pressure", "force", "velocity")}
+        scales = {q: getattr(self, q) for q in ("length", "height", "time", "pressure", "force", "velocity")}
         if quantity not in scales:
             raise SceneError(f"unknown quantity {quantity!r}; choose one of {sorted(scales)}.")
         return np.asarray(value) * scales[quantity]
@@ -691,11 +727,12 @@ class Dimensional:
             ``p_max_y`` [m]; the units are in :attr:`RESULT_COLUMNS`.
         """
         s = result.summary()
-        return {name: np.asarray(self.to_si(scale, s[col]), dtype=float)
-                for name, (col, scale, _unit) in self.RESULT_COLUMNS.items()}
+        return {
+            name: np.asarray(self.to_si(scale, s[col]), dtype=float)
+            for name, (col, scale, _unit) in self.RESULT_COLUMNS.items()
+        }
 
-    def scene(self, h0: float, t1: float | None = None, T: float | None = None,
-              L: float = 2.0) -> Scene:
+    def scene(self, h0: float, t1: float | None = None, T: float | None = None, L: float = 2.0) -> Scene:
         """The paper's ramp-hold-slide experiment for these SI values.
 
         Parameters

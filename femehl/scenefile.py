@@ -82,8 +82,17 @@ __all__ = [
 
 SUBSTRATES = {"halfspace": HalfSpace, "winkler": Winkler, "rigid": Rigid}
 TIME_FUNCTIONS = {"constant": Constant, "table": Table, "ramp_hold": RampHold, "tanh": TanhStart}
-RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "mesh", "dr", "dtheta_divisions",
-            "linear_solver"}
+RUN_KEYS = {
+    "method",
+    "scheme",
+    "t_end",
+    "dt",
+    "store_every",
+    "mesh",
+    "dr",
+    "dtheta_divisions",
+    "linear_solver",
+}
 #: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
 LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading"}
 
@@ -94,8 +103,9 @@ def _build(registry, table, where, path):
     table = dict(table)
     kind = table.pop("kind", None)
     if kind not in registry:
-        raise SceneFileError(f"{path}: [{where}] kind = {kind!r} is not known; "
-                             f"use one of {sorted(registry)}.")
+        raise SceneFileError(
+            f"{path}: [{where}] kind = {kind!r} is not known; use one of {sorted(registry)}."
+        )
     cls = registry[kind]
     if "file" in table and hasattr(cls, "from_file"):
         # data read from a file next to the scene file (e.g. a height map .npz)
@@ -105,8 +115,10 @@ def _build(registry, table, where, path):
         allowed = set(inspect.signature(cls.from_file).parameters) - {"path"}
         extra = set(table) - allowed
         if extra:
-            raise SceneFileError(f"{path}: [{where}] kind = {kind!r} with file = ... does not take "
-                                 f"{sorted(extra)}; it takes {sorted(allowed | {'file'})}.")
+            raise SceneFileError(
+                f"{path}: [{where}] kind = {kind!r} with file = ... does not take "
+                f"{sorted(extra)}; it takes {sorted(allowed | {'file'})}."
+            )
         try:
             return cls.from_file(file, **table)
         except (SceneError, TypeError) as exc:
@@ -114,8 +126,9 @@ def _build(registry, table, where, path):
     allowed = set(inspect.signature(cls).parameters)
     extra = set(table) - allowed
     if extra:
-        raise SceneFileError(f"{path}: [{where}] kind = {kind!r} does not take {sorted(extra)}; "
-                             f"it takes {sorted(allowed)}.")
+        raise SceneFileError(
+            f"{path}: [{where}] kind = {kind!r} does not take {sorted(extra)}; it takes {sorted(allowed)}."
+        )
     try:
         return cls(**table)
     except SceneError as exc:
@@ -138,7 +151,7 @@ def load_scene_file(path) -> tuple[Scene, dict]:
 
     A file whose ``[indenter]`` has ``kind = "cylinder"`` states line contact:
     the scene is then a :class:`femehl.line.LineScene` and the run options
-    those of :func:`femehl.line.solve_line` (see :data:`LINE_RUN_KEYS`).
+    those of :func:`femehl.api.solve_line` (see :data:`LINE_RUN_KEYS`).
 
     When the file states the scene in SI units (an ``[si]`` table), the run
     options also hold the :class:`~femehl.scene.Dimensional` under the key
@@ -203,14 +216,21 @@ def _check_run(run: dict, path: pathlib.Path) -> None:
     height map's ``file``).
     """
     if "dtheta_divisions" in run:
-        check_int(f"{path}: [run] dtheta_divisions", run["dtheta_divisions"], minimum=2,
-                  hint="It is the number of angular divisions of the half turn (dtheta = pi/n), "
-                       "e.g. dtheta_divisions = 30.", error=SceneFileError)
+        check_int(
+            f"{path}: [run] dtheta_divisions",
+            run["dtheta_divisions"],
+            minimum=2,
+            hint="It is the number of angular divisions of the half turn (dtheta = pi/n), "
+            "e.g. dtheta_divisions = 30.",
+            error=SceneFileError,
+        )
     if "mesh" in run:
         mesh = run["mesh"]
         if not isinstance(mesh, str) or not mesh.strip():
-            raise SceneFileError(f"{path}: [run] mesh must be a ladder name (coarse, medium, fine, "
-                                 f"xfine) or the path of a mesh file, got {mesh!r}.")
+            raise SceneFileError(
+                f"{path}: [run] mesh must be a ladder name (coarse, medium, fine, "
+                f"xfine) or the path of a mesh file, got {mesh!r}."
+            )
         from .fe.mesh import LADDER  # lazy: only scene files that name a mesh need the FE code
 
         if mesh not in LADDER and not pathlib.Path(mesh).is_absolute():
@@ -221,8 +241,10 @@ def _si_scene(raw, path):
     """The paper's experiment in SI units; returns (scene, Dimensional)."""
     clash = {"substrate", "fluid", "motion", "domain"} & set(raw)
     if clash:
-        raise SceneFileError(f"{path}: [si] replaces {sorted(clash)}; give one or the other "
-                             "(only [indenter] may accompany [si], in metres).")
+        raise SceneFileError(
+            f"{path}: [si] replaces {sorted(clash)}; give one or the other "
+            "(only [indenter] may accompany [si], in metres)."
+        )
     si = raw["si"]
     if not isinstance(si, dict):
         raise SceneFileError(f"{path}: [si] must be a table.")
@@ -232,8 +254,10 @@ def _si_scene(raw, path):
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
     if extra or missing:
-        raise SceneFileError(f"{path}: [si] needs {sorted(keys - optional)} "
-                             f"(optional {sorted(optional)}); missing {sorted(missing)}, unknown {sorted(extra)}.")
+        raise SceneFileError(
+            f"{path}: [si] needs {sorted(keys - optional)} "
+            f"(optional {sorted(optional)}); missing {sorted(missing)}, unknown {sorted(extra)}."
+        )
     try:
         dim = Dimensional(**{k: si[k] for k in ("R", "G", "eta", "V_ss", "h_inf")}, nu=si.get("nu", 0.5))
         scene = dim.scene(si["h0"], si.get("t1"), si.get("T"), si.get("L", 2.0))
@@ -247,8 +271,9 @@ def _si_scene(raw, path):
             changes["indenter"] = si_indenter(kind, ind, dim)
         if "load" in si:
             F = check_finite("[si] load [N]", si["load"]) / dim.force
-            changes["motion"] = Motion(gap=Constant(scene.motion.hc(0.0)),
-                                       velocity=scene.motion.velocity, load=Constant(F))
+            changes["motion"] = Motion(
+                gap=Constant(scene.motion.hc(0.0)), velocity=scene.motion.velocity, load=Constant(F)
+            )
         if changes:
             scene = dataclasses.replace(scene, **changes)
     except SceneFileError:
@@ -268,8 +293,9 @@ def _normalized_scene(raw, path):
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
-    return Scene(indenter=indenter, substrate=substrate, fluid=Fluid(**fluid),
-                 motion=motion, domain=Domain(**domain))
+    return Scene(
+        indenter=indenter, substrate=substrate, fluid=Fluid(**fluid), motion=motion, domain=Domain(**domain)
+    )
 
 
 def _motion(raw, path) -> Motion:
@@ -299,29 +325,34 @@ def _line_scene(raw, path):
     from .line import LineScene
 
     if "si" in raw:
-        raise SceneFileError(f"{path}: [si] states the sphere experiment; line contact "
-                             "([indenter] kind = \"cylinder\") is stated in normalized units: "
-                             "replace [si] by [substrate], [fluid], [motion] and [domain].")
+        raise SceneFileError(
+            f"{path}: [si] states the sphere experiment; line contact "
+            '([indenter] kind = "cylinder") is stated in normalized units: '
+            "replace [si] by [substrate], [fluid], [motion] and [domain]."
+        )
     ind = dict(raw["indenter"])
     ind.pop("kind")
     extra = set(ind) - {"R"}
     if extra:
-        raise SceneFileError(f"{path}: [indenter] kind = 'cylinder' does not take {sorted(extra)}; "
-                             "it takes only R (= 1).")
+        raise SceneFileError(
+            f"{path}: [indenter] kind = 'cylinder' does not take {sorted(extra)}; it takes only R (= 1)."
+        )
     if "R" in ind:
         R = ind["R"]
         if isinstance(R, bool) or not isinstance(R, (int, float)) or R != 1:
             raise SceneFileError(
                 f"{path}: [indenter] kind = 'cylinder' has R = {R!r}, but line contact is "
                 "normalized by the cylinder's radius (gap x^2/2): R must be 1.0 (or left out). "
-                "Rescale the other parameters instead.")
+                "Rescale the other parameters instead."
+            )
     sub = raw.get("substrate")
     if not isinstance(sub, dict) or sub.get("kind") != "winkler":
         got = sub.get("kind") if isinstance(sub, dict) else sub
         raise SceneFileError(
             f"{path}: [substrate] kind = {got!r}: line contact needs a Winkler foundation "
             "([indenter] kind = 'cylinder'); give [substrate] kind = \"winkler\" with k = ..., "
-            "or use a 3-D indenter (e.g. kind = \"sphere\") for other substrates.")
+            'or use a 3-D indenter (e.g. kind = "sphere") for other substrates.'
+        )
     winkler = _build(SUBSTRATES, sub, "substrate", path)
     fluid = raw.get("fluid", {})
     if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
@@ -345,12 +376,16 @@ def _line_run(run, path):
     """Check the [run] table of a line-contact scene."""
     extra = set(run) - LINE_RUN_KEYS
     if extra:
-        raise SceneFileError(f"{path}: [run] of a line contact ([indenter] kind = 'cylinder') "
-                             f"does not take {sorted(extra)}; it takes {sorted(LINE_RUN_KEYS)}.")
+        raise SceneFileError(
+            f"{path}: [run] of a line contact ([indenter] kind = 'cylinder') "
+            f"does not take {sorted(extra)}; it takes {sorted(LINE_RUN_KEYS)}."
+        )
     method = run.pop("method", "line")
     if method != "line":
-        raise SceneFileError(f"{path}: [run] method = {method!r}: line contact is solved by "
-                             "method = \"line\" (or leave method out).")
+        raise SceneFileError(
+            f"{path}: [run] method = {method!r}: line contact is solved by "
+            'method = "line" (or leave method out).'
+        )
     return run
 
 
@@ -360,6 +395,8 @@ def run_options(run: dict) -> dict:
     if "dtheta_divisions" in out:
         n = out.pop("dtheta_divisions")
         if not isinstance(n, int) or n < 2:
-            raise SceneFileError(f"[run] dtheta_divisions must be an integer >= 2 (dtheta = pi/n), got {n!r}.")
+            raise SceneFileError(
+                f"[run] dtheta_divisions must be an integer >= 2 (dtheta = pi/n), got {n!r}."
+            )
         out["dtheta"] = math.pi / n
     return out

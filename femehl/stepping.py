@@ -11,8 +11,9 @@ step, so a caller can stop, store or plot whenever it likes.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Iterator, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -44,8 +45,8 @@ class State:
     p_max: float
     p_max_at: tuple
     info: dict = field(default_factory=dict)
-    d_prev: np.ndarray | None = None      # d one step earlier (two-step schemes)
-    dt_prev: float | None = None          # the step that led to this state
+    d_prev: np.ndarray | None = None  # d one step earlier (two-step schemes)
+    dt_prev: float | None = None  # the step that led to this state
 
 
 class Stepper(Protocol):
@@ -120,8 +121,9 @@ def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None)
         state = start
         k0 = int(round(start.t / dt))
         if abs(k0 * dt - start.t) > 1e-9 * max(1.0, start.t):
-            raise SceneError(f"cannot resume at t = {start.t:g} with dt = {dt:g}: "
-                             "resume with the dt of the original run.")
+            raise SceneError(
+                f"cannot resume at t = {start.t:g} with dt = {dt:g}: resume with the dt of the original run."
+            )
     yield state
     for k in range(k0 + 1, n + 1):
         t_new = min(k * dt, t_end)
@@ -135,8 +137,10 @@ def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None)
 
 def _film_floor(state: State):
     """The thinnest film the step knows of, and where: film points, origin, probed nodes."""
-    cands = [(state.film_min, tuple(state.film_min_at), "the film points"),
-             (state.film_center, (0.0, 0.0), "the origin")]
+    cands = [
+        (state.film_min, tuple(state.film_min_at), "the film points"),
+        (state.film_center, (0.0, 0.0), "the origin"),
+    ]
     if "node_film_min" in state.info:
         cands.append((state.info["node_film_min"], tuple(state.info["node_film_min_at"]), "a node"))
     bad = [c for c in cands if not math.isfinite(c[0])]
@@ -151,4 +155,7 @@ def _check_film(state: State):
             f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
             "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
             "load truly squeezes the film out, the lubricated model no longer applies.",
-            t=state.t, where=(x, y), d_min=d)
+            t=state.t,
+            where=(x, y),
+            d_min=d,
+        )

@@ -51,8 +51,9 @@ def check_finite(name: str, value, hint: str = "") -> float:
     (a "1" in a scene is a typo, not a number).
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise SceneError(_join(f"{name} must be a real number, got {short(value)} "
-                               f"({type(value).__name__}).", hint))
+        raise SceneError(
+            _join(f"{name} must be a real number, got {short(value)} ({type(value).__name__}).", hint)
+        )
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError):
@@ -84,8 +85,7 @@ def check_int(name: str, value, minimum: int | None = None, hint: str = "", erro
     Booleans and floats (even 3.0) are refused: a count is written as an integer.
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise error(_join(f"{name} must be an integer, got {short(value)} ({type(value).__name__}).",
-                          hint))
+        raise error(_join(f"{name} must be an integer, got {short(value)} ({type(value).__name__}).", hint))
     v = int(value)
     if minimum is not None and v < minimum:
         raise error(_join(f"{name} must be an integer >= {minimum}, got {v}.", hint))
@@ -100,19 +100,29 @@ def check_shape_values(what: str, values, shape: tuple, hint: str = "") -> np.nd
     """
     a = np.asarray(values)
     if np.iscomplexobj(a):
-        raise SceneError(_join(f"{what} returned complex values (e.g. {complex(a.ravel()[0]):.3g}): "
-                               "a gap is a real number; return the real part or fix the formula "
-                               "(a square root of a negative number?).", hint))
+        raise SceneError(
+            _join(
+                f"{what} returned complex values (e.g. {complex(a.ravel()[0]):.3g}): "
+                "a gap is a real number; return the real part or fix the formula "
+                "(a square root of a negative number?).",
+                hint,
+            )
+        )
     try:
-        a = np.array(a, dtype=float)          # a copy: the caller's array is never touched
+        a = np.array(a, dtype=float)  # a copy: the caller's array is never touched
     except (TypeError, ValueError):
-        raise SceneError(_join(f"{what} must return real numbers, got {type(values).__name__}.",
-                               hint)) from None
+        raise SceneError(
+            _join(f"{what} must return real numbers, got {type(values).__name__}.", hint)
+        ) from None
     if a.shape != tuple(shape):
         if a.ndim != 0:
-            raise SceneError(_join(f"{what} returned shape {a.shape} for inputs of shape "
-                                   f"{tuple(shape)}: return one value per point (vectorize with numpy).",
-                                   hint))
+            raise SceneError(
+                _join(
+                    f"{what} returned shape {a.shape} for inputs of shape "
+                    f"{tuple(shape)}: return one value per point (vectorize with numpy).",
+                    hint,
+                )
+            )
         a = np.full(shape, float(a))
     return a
 
@@ -129,6 +139,8 @@ def call_time_function(history: str, symbol: str, f, t: float, hint: str = "") -
     except SceneError:
         raise
     except Exception as exc:  # noqa: BLE001 - the user's code: say which history failed, and when
-        raise SceneError(f"{history} raised {type(exc).__name__} at t = {t:g} ({exc}): fix the "
-                         "function so that it returns a finite number at every time of the run.") from None
+        raise SceneError(
+            f"{history} raised {type(exc).__name__} at t = {t:g} ({exc}): fix the "
+            "function so that it returns a finite number at every time of the run."
+        ) from None
     return check_finite(f"{symbol}(t={t:g})", v, hint)

@@ -32,21 +32,24 @@ def _rows(folder):
     return (pathlib.Path(folder) / "summary.csv").read_text().splitlines()
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--method", "fd", "--mesh", "coarse"], ["--mesh", "--method fe"]),
-    (["--dr", "0.1"], ["--dr", "--method fd"]),
-    (["--dtheta-divisions", "12"], ["--dtheta-divisions", "--method fd"]),
-    (["--method", "fd", "--scheme", "bdf2"], ["--scheme"]),
-    (["--method", "fd", "--dtheta-divisions", "0"], ["--dtheta-divisions", ">= 2"]),
-    (["--method", "fd", "--dtheta-divisions", "-4"], ["--dtheta-divisions", ">= 2"]),
-    (["--method", "fd", "--dr", "0"], ["--dr", "> 0"]),
-    (["--mesh", "coarse", "--store-every", "-1"], ["store_every", ">= 0"]),
-    (["--mesh", "coarse", "--dt", "0"], ["dt must be > 0"]),
-    (["--mesh", "coarse", "--t-end", "nan"], ["t_end must be finite"]),
-    (["--mesh", "coarse", "--t-end", "inf"], ["t_end must be finite"]),
-    (["--mesh", "coarse", "--resume", "--overwrite"], ["--resume", "--overwrite"]),
-    (["--n-elements", "10"], ["--n-elements"]),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--method", "fd", "--mesh", "coarse"], ["--mesh", "--method fe"]),
+        (["--dr", "0.1"], ["--dr", "--method fd"]),
+        (["--dtheta-divisions", "12"], ["--dtheta-divisions", "--method fd"]),
+        (["--method", "fd", "--scheme", "bdf2"], ["--scheme"]),
+        (["--method", "fd", "--dtheta-divisions", "0"], ["--dtheta-divisions", ">= 2"]),
+        (["--method", "fd", "--dtheta-divisions", "-4"], ["--dtheta-divisions", ">= 2"]),
+        (["--method", "fd", "--dr", "0"], ["--dr", "> 0"]),
+        (["--mesh", "coarse", "--store-every", "-1"], ["store_every", ">= 0"]),
+        (["--mesh", "coarse", "--dt", "0"], ["dt must be > 0"]),
+        (["--mesh", "coarse", "--t-end", "nan"], ["t_end must be finite"]),
+        (["--mesh", "coarse", "--t-end", "inf"], ["t_end must be finite"]),
+        (["--mesh", "coarse", "--resume", "--overwrite"], ["--resume", "--overwrite"]),
+        (["--n-elements", "10"], ["--n-elements"]),
+    ],
+)
 def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, args, words):
     out = tmp_path / "o"
     rc = main(["run", "--t-end", "0.04", "--quiet", *args, "--out", str(out)])
@@ -59,8 +62,29 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, args, words):
 
 def test_fd_accepts_scheme_euler(tmp_path):
     out = tmp_path / "o"
-    assert main(["run", "--method", "fd", "--scheme", "euler", "--dr", "0.2", "--dtheta-divisions", "8",
-                 "--t-end", "0.04", "--dt", "0.02", "--out", str(out), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                "--method",
+                "fd",
+                "--scheme",
+                "euler",
+                "--dr",
+                "0.2",
+                "--dtheta-divisions",
+                "8",
+                "--t-end",
+                "0.04",
+                "--dt",
+                "0.02",
+                "--out",
+                str(out),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     assert len(_rows(out)) == 1 + 3
 
 
@@ -77,8 +101,12 @@ def test_regression_bad_store_every_keeps_the_run_and_resume_goes_on(tmp_path, c
     out = str(tmp_path / "o")
     assert main(BASE + ["--t-end", "0.04", "--out", out]) == 0
     before, rows = _snapshot(out), _rows(out)
-    for bad in (["--store-every", "-1"], ["--store-every", "-1", "--resume"],
-                ["--store-every", "-1", "--overwrite"], ["--t-end", "nan", "--resume"]):
+    for bad in (
+        ["--store-every", "-1"],
+        ["--store-every", "-1", "--resume"],
+        ["--store-every", "-1", "--overwrite"],
+        ["--t-end", "nan", "--resume"],
+    ):
         assert main(BASE + ["--t-end", "0.08", "--out", out, *bad]) == 2
         assert _snapshot(out) == before
     capsys.readouterr()
@@ -113,6 +141,7 @@ def test_ctrl_c_exits_130_and_prints_the_resume_command(tmp_path, capsys, monkey
             if calls[0] > 2:
                 raise KeyboardInterrupt
             return orig(*sa, **sk)
+
         stepper.step = step
         return stepper
 
@@ -123,7 +152,7 @@ def test_ctrl_c_exits_130_and_prints_the_resume_command(tmp_path, capsys, monkey
     err = capsys.readouterr().err
     line = next(ln.strip() for ln in err.splitlines() if ln.strip().startswith("femehl run"))
     assert line.endswith(f"--resume --out {shlex.quote(str(out))}")
-    assert len(_rows(out)) == 1 + 3                              # t = 0, 0.02, 0.04
+    assert len(_rows(out)) == 1 + 3  # t = 0, 0.02, 0.04
     monkeypatch.undo()
     assert main(shlex.split(line)[1:]) == 0
     assert len(_rows(out)) == 1 + 6

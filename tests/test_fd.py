@@ -15,12 +15,8 @@ import numpy as np
 import pytest
 
 from femehl import api
-from femehl.errors import SceneError
 from femehl.api import make_stepper
-
-
-def FDStep(scene, **kw):
-    return make_stepper(scene, "fd", **kw)
+from femehl.errors import SceneError
 from femehl.presets import paper_sphere
 from femehl.scene import (
     Dimensional,
@@ -35,6 +31,11 @@ from femehl.scene import (
     Table,
     Winkler,
 )
+
+
+def FDStep(scene, **kw):
+    return make_stepper(scene, "fd", **kw)
+
 
 F_HERTZ = 4.0 / (3.0 * math.pi)  # normalized Hertz load at hc = -1 (docs/design.md, section 2)
 P0_HERTZ = 2.0 / math.pi**2  # normalized Hertz central pressure
@@ -92,8 +93,7 @@ def test_rigid_scene_is_valid_and_sparse():
     assert eff["squeeze"] and not eff["sliding"] and eff["elasticity"] == "rigid"
     st = FDStep(sc, dr=0.1, dtheta=math.pi / 6)
     assert not isinstance(st.C, np.ndarray)
-    assert not FDStep(Scene(substrate=Winkler(1.0), motion=sc.motion), dr=0.1,
-                      dtheta=math.pi / 6).dense
+    assert not FDStep(Scene(substrate=Winkler(1.0), motion=sc.motion), dr=0.1, dtheta=math.pi / 6).dense
 
 
 @pytest.fixture(scope="module")
@@ -288,10 +288,10 @@ def test_hertz_pressure_on_grid_reference():
         st = FDStep(paper_sphere(), dr=dr, dtheta=math.pi / 12).disc
         W = HalfSpace().compliance_operator(st)
         g = st.grid
-        pH = P0_HERTZ * np.sqrt(np.clip(1.0 - st.r ** 2, 0.0, None))
-        pf = pH.reshape(g.m, g.n)[1:-1, 1:-1].ravel()       # free unknowns: interior nodes
-        off_centre = st.r > 0                               # p(0) is copied from r = dr (Eq. 17a)
-        assert np.allclose((st.E @ pf)[off_centre], pH[off_centre])   # mirror rows, rim p = 0
+        pH = P0_HERTZ * np.sqrt(np.clip(1.0 - st.r**2, 0.0, None))
+        pf = pH.reshape(g.m, g.n)[1:-1, 1:-1].ravel()  # free unknowns: interior nodes
+        off_centre = st.r > 0  # p(0) is copied from r = dr (Eq. 17a)
+        assert np.allclose((st.E @ pf)[off_centre], pH[off_centre])  # mirror rows, rim p = 0
         w0 = -float((W @ pf)[0])
         load = 2.0 * float(np.sum((st.E @ pf) * st.area))
         out.append((abs(w0 + 1.0), abs(load / F_HERTZ - 1.0)))

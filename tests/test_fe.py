@@ -10,9 +10,8 @@ import pytest
 import scipy.sparse as sp
 
 import femehl
-from femehl.api import make_stepper
 from femehl.core.terms import StepContext
-from femehl.scene import Constant, Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
+from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
 
 
 def rigid_scene(beta=1.0, V=0.0):
@@ -36,7 +35,7 @@ def test_patch_linear_pressure_has_zero_residual():
     nodes = disc.nodes
     d = np.full(disc.nelements, 0.37)
     n = disc.nnodes
-    data = (disc._k_data * (d ** 3)[None, :]).ravel()
+    data = (disc._k_data * (d**3)[None, :]).ravel()
     K = sp.csr_matrix((data, (disc._k_rows, disc._k_cols)), shape=(n, n))
     for a, b, c in [(1.0, 0.0, 0.0), (0.3, -2.0, 0.0), (0.0, 0.7, 1.3)]:
         p = a + b * nodes[:, 0] + c * nodes[:, 1]
@@ -67,8 +66,9 @@ def test_step_reproduces_a_p1_pressure(linear_solver):
     d = 0.05 + rng.random(st.disc.nelements)
     pstar = rng.random(st.disc.n)
     for V, dt in [(0.0, 0.01), (0.7, 0.01), (0.7, 0.01)]:
-        ctx = StepContext(t_new=0.0, dt=dt, a0=1.0, d=d, d_lag=d, history=d, p=np.zeros(st.disc.n),
-                          V=V, beta=st.beta)
+        ctx = StepContext(
+            t_new=0.0, dt=dt, a0=1.0, d=d, d_lag=d, history=d, p=np.zeros(st.disc.n), V=V, beta=st.beta
+        )
         op, _ = st.operator(ctx)
         A = op.matrix()
         b = A @ pstar
@@ -164,7 +164,7 @@ def test_linear_solver_paths_agree(opts):
     sc = femehl.presets.paper_sphere()
     kw = dict(mesh="coarse", t_end=1.6, dt=0.02, store_every=20, rtol=1e-10)
     ref = femehl.solve(sc, "fe", **kw)
-    if opts.get("linear_solver") == "lu":        # a direct solve has no tolerance to give
+    if opts.get("linear_solver") == "lu":  # a direct solve has no tolerance to give
         kw.pop("rtol")
     other = femehl.solve(sc, "fe", **kw, **opts)
     for a, b in zip(ref.states, other.states, strict=True):

@@ -22,11 +22,11 @@ def test_tip_film_closing_between_centroids_stops_the_run():
         for s in femehl.steps(sc, 0.5, 0.01, mesh="coarse"):
             states.append(s)
     err = info.value
-    assert err.d_min <= 0.0 and np.hypot(*err.where) < 0.05          # at the tip
+    assert err.d_min <= 0.0 and np.hypot(*err.where) < 0.05  # at the tip
     assert "origin" in str(err) or "node" in str(err)
     assert 0.1 < err.t < 0.4
     last = states[-1]
-    assert last.film_min > 1e-3                                      # the centroids never saw it
+    assert last.film_min > 1e-3  # the centroids never saw it
     for s in states[1:]:
         assert s.film_center > 0.0
         assert s.info.get("node_film_min", np.inf) > 0.0

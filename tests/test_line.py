@@ -25,12 +25,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from femehl.errors import SceneError
-from femehl.api import make_stepper
+from femehl.api import make_stepper, solve_line
 from femehl.core.terms import StepContext
-from femehl.line import LineScene, line_nodes, solve_line
-from femehl.result import Result
+from femehl.errors import SceneError
+from femehl.line import LineScene, line_nodes
 from femehl.line_steady import steady_line, steady_line_load
+from femehl.result import Result
 from femehl.scene import Constant, Motion, RampHold, TanhStart
 from femehl.stepping import State
 
@@ -105,7 +105,7 @@ def test_transient_reaches_exact_steady_state(runs, exact):
     assert film_order > 1.6 and load_order > 1.6, (film_order, load_order)
     for r in runs.values():
         assert isinstance(r, Result)
-        assert np.all(r.film_min > 0)                       # the film never closed
+        assert np.all(r.film_min > 0)  # the film never closed
         i = np.searchsorted(r.t, 14.0)
         assert abs(r.load[-1] - r.load[i]) < 1e-8  # steady: nothing changes
         assert abs(r.film_center[-1] - r.film_center[i]) < 1e-8
@@ -134,8 +134,8 @@ def test_result_arrays_and_states(runs):
     assert isinstance(s, State) and s.t == pytest.approx(7.0)
     assert s.p.shape == r.disc.x.shape and s.d.shape == r.disc.xc.shape and s.w.shape == r.disc.xc.shape
     assert s.p[0] == 0.0 and s.p[-1] == 0.0
-    assert np.allclose(s.d, s.hc + r.disc.xc ** 2 / 2 - s.w)
-    assert s.load == pytest.approx(np.trapezoid(s.p, r.disc.x), rel=1e-12)   # P1: trapezoid is exact
+    assert np.allclose(s.d, s.hc + r.disc.xc**2 / 2 - s.w)
+    assert s.load == pytest.approx(np.trapezoid(s.p, r.disc.x), rel=1e-12)  # P1: trapezoid is exact
 
 
 # ---------------------------------------------------------------------------
@@ -244,17 +244,26 @@ def test_step_matrix_is_sparse(load):
     st = make_stepper(sliding_scene(motion=motion, load=load), "line", n_elements=300)
     s0 = st.initial_state()
     s1 = st.step(s0, 0.05, 0.05)
-    ctx = StepContext(t_new=1.5, dt=0.05, a0=1.0, d=s1.d, d_lag=s1.d, history=s1.d,
-                      p=s1.p[st.disc.free], V=0.5, beta=st.beta)
+    ctx = StepContext(
+        t_new=1.5,
+        dt=0.05,
+        a0=1.0,
+        d=s1.d,
+        d_lag=s1.d,
+        history=s1.d,
+        p=s1.p[st.disc.free],
+        V=0.5,
+        beta=st.beta,
+    )
     op, b = st.operator(ctx)
     A = op.matrix()
     n = st.disc.n
     assert sp.issparse(A) and A.format == "csc" and not op.dense
     assert A.shape == (n, n) and b.shape == (n,)
-    assert A.nnz <= 3 * n                                        # tridiagonal
+    assert A.nnz <= 3 * n  # tridiagonal
     for obj in (st, st.disc):
         for name, v in vars(obj).items():
-            if isinstance(v, np.ndarray):                        # O(n) data, no dense operator
+            if isinstance(v, np.ndarray):  # O(n) data, no dense operator
                 assert v.ndim == 1 or v.size <= 4 * st.disc.nelements, name
             elif sp.issparse(v):
                 assert v.nnz <= 4 * max(v.shape), name

@@ -8,9 +8,10 @@ import pathlib
 import numpy as np
 import pytest
 
+from femehl.api import solve_line
 from femehl.cli import main
 from femehl.errors import SceneFileError
-from femehl.line import LineScene, solve_line
+from femehl.line import LineScene
 from femehl.output.table import COLUMNS
 from femehl.scene import Motion, RampHold, TanhStart
 from femehl.scenefile import load_scene_file
@@ -35,11 +36,11 @@ def test_cli_runs_line_contact(tmp_path, capsys):
     rc = main(["run", str(TOML), "--t-end", "2", "--dt", "0.05", "--out", str(out), "--quiet"])
     assert rc == 0
     cap = capsys.readouterr()
-    text = cap.out + cap.err          # the run's report goes to stderr, the figures to stdout
+    text = cap.out + cap.err  # the run's report goes to stderr, the figures to stdout
     assert "elasticity=winkler" in text and "sliding=True" in text and "squeeze=True" in text
     assert "t = 1:" in text and "t = 2:" in text
     assert (out / "line.png").stat().st_size > 0
-    assert (out / "fields.pvd").is_file() and (out / "checkpoint.npz").is_file()   # a run folder
+    assert (out / "fields.pvd").is_file() and (out / "checkpoint.npz").is_file()  # a run folder
     with open(out / "summary.csv", newline="") as fh:
         rows = list(csv.reader(fh))
     assert tuple(rows[0]) == COLUMNS

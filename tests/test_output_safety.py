@@ -89,7 +89,7 @@ def test_overwrite_removes_only_femehls_files(old_run):
     _run(old_run, t_end=0.02, store_every=2, overwrite=True)
     assert (old_run / "notes.txt").read_bytes() == USER
     assert (old_run / "fields_mine.vtu.bak").read_bytes() == USER
-    assert not (old_run / "summary_si.csv").exists()                  # the old run's, gone
+    assert not (old_run / "summary_si.csv").exists()  # the old run's, gone
     assert sorted(p.name for p in old_run.glob("fields_*.vtu")) == [f for _, f in _times(old_run)]
     assert [t for t, _ in _times(old_run)] == pytest.approx([0.0, 0.02])
     assert len(_rows(old_run)) == 1 + 2
@@ -102,11 +102,21 @@ def test_a_folder_with_user_files_only_is_used(tmp_path):
     assert (tmp_path / "summary.csv").is_file()
 
 
-@pytest.mark.parametrize("bad", [
-    {"store_every": -1}, {"checkpoint_every": -1}, {"store_every": 1.5}, {"t_end": math.nan},
-    {"dt": 0.0}, {"mesh": "no-such-mesh"}, {"colour": "red"}, {"resume": True, "overwrite": True},
-    {"method": "nope"}, {"progress": "yes"},
-])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        {"store_every": -1},
+        {"checkpoint_every": -1},
+        {"store_every": 1.5},
+        {"t_end": math.nan},
+        {"dt": 0.0},
+        {"mesh": "no-such-mesh"},
+        {"colour": "red"},
+        {"resume": True, "overwrite": True},
+        {"method": "nope"},
+        {"progress": "yes"},
+    ],
+)
 @pytest.mark.parametrize("mode", [{}, {"resume": True}, {"overwrite": True}])
 def test_bad_options_touch_nothing(old_run, bad, mode):
     """Regression: ``--store-every -1`` on a run folder used to wipe its summary.csv."""
@@ -189,8 +199,17 @@ def _damage(folder: pathlib.Path, how: str) -> str:
     return npz.name
 
 
-DAMAGE = ["truncated npz", "garbage npz", "not a zip", "missing key", "wrong size", "json list",
-          "json missing keys", "json garbage", "json missing"]
+DAMAGE = [
+    "truncated npz",
+    "garbage npz",
+    "not a zip",
+    "missing key",
+    "wrong size",
+    "json list",
+    "json missing keys",
+    "json garbage",
+    "json missing",
+]
 
 
 @pytest.mark.parametrize("how", DAMAGE)
@@ -226,6 +245,7 @@ def test_output_path_is_a_file(tmp_path):
 
 def test_output_path_not_writable(tmp_path, monkeypatch):
     import femehl.output.folder as fo
+
     monkeypatch.setattr(fo, "_writable", lambda p: False)
     with pytest.raises(OutputError, match="not writable") as info:
         _run(tmp_path / "x")
@@ -245,7 +265,7 @@ def test_result_save_checks_the_folder(tmp_path):
     with pytest.raises(OutputError, match="already holds a run"):
         res.save(tmp_path / "r")
     assert _snapshot(tmp_path / "r") == before
-    (tmp_path / "r" / "fields_000009.vtu").write_bytes(USER)          # a stale file of that run
+    (tmp_path / "r" / "fields_000009.vtu").write_bytes(USER)  # a stale file of that run
     (tmp_path / "r" / "notes.txt").write_bytes(USER)
     write_all(res, tmp_path / "r", overwrite=True)
     assert not (tmp_path / "r" / "fields_000009.vtu").exists()
@@ -262,12 +282,13 @@ def test_a_write_failure_names_the_folder_and_keeps_the_last_checkpoint(tmp_path
         if calls[0] > 3:
             raise OSError(28, "No space left on device")
         return real(self, state)
+
     monkeypatch.setattr(SummaryWriter, "write", write)
     with pytest.raises(OutputError) as info:
         _run(tmp_path, t_end=0.1)
     assert str(tmp_path) in str(info.value) and "resume" in str(info.value)
     assert "No space left" in str(info.value)
-    assert checkpoint.load_checkpoint(tmp_path).t == pytest.approx(0.04)   # the last state written
+    assert checkpoint.load_checkpoint(tmp_path).t == pytest.approx(0.04)  # the last state written
 
 
 # ---- Ctrl-C ----------------------------------------------------------------------------------
@@ -284,8 +305,10 @@ def interrupting(after: int):
             if calls[0] > after:
                 raise KeyboardInterrupt
             return orig(*sa, **sk)
+
         stepper.step = step
         return stepper
+
     return make
 
 
@@ -297,8 +320,8 @@ def test_interrupt_leaves_readable_output_and_resumes(tmp_path, monkeypatch):
     assert info.value.result.t[-1] == pytest.approx(0.06)
     rows = _rows(out)
     assert [float(r[0]) for r in rows[1:]] == pytest.approx([0.0, 0.02, 0.04, 0.06])
-    assert [t for t, _ in _times(out)] == pytest.approx([0.0, 0.04, 0.06])   # last state written
-    assert checkpoint.load_checkpoint(out).t == pytest.approx(0.06)         # the last good state
+    assert [t for t, _ in _times(out)] == pytest.approx([0.0, 0.04, 0.06])  # last state written
+    assert checkpoint.load_checkpoint(out).t == pytest.approx(0.06)  # the last good state
     monkeypatch.undo()
     run_to_folder(SC, out, t_end=0.1, mesh="coarse", dt=0.02, store_every=2, resume=True)
     full = tmp_path / "full"
@@ -350,22 +373,23 @@ def test_no_earlier_data_is_lost(tmp_path_factory, state, action, stray):
     except (OutputError, SceneError) as exc:
         error = exc
     after = _read(folder) if folder.is_dir() else {}
-    assert {n: after.get(n) for n in user} == user                       # user files: never touched
+    assert {n: after.get(n) for n in user} == user  # user files: never touched
     if error is not None:
-        assert after == before                                            # refused: nothing touched
-    expect_refusal = ((action == "new" and held_run)
-                      or (action == "resume" and state in ("empty", "missing", "user only",
-                                                           "damaged checkpoint")))
+        assert after == before  # refused: nothing touched
+    expect_refusal = (action == "new" and held_run) or (
+        action == "resume" and state in ("empty", "missing", "user only", "damaged checkpoint")
+    )
     assert (error is not None) == expect_refusal, error
     if error is not None or action == "overwrite":
-        if action == "overwrite":                                          # the old run's files are gone
+        if action == "overwrite":  # the old run's files are gone
             assert "summary_si.csv" not in after
-            assert sorted(n for n in after if n.startswith("fields_") and n.endswith(".vtu")) == \
-                [f for _, f in _times(folder)]
+            assert sorted(n for n in after if n.startswith("fields_") and n.endswith(".vtu")) == [
+                f for _, f in _times(folder)
+            ]
         return
     if action == "resume":
         for n, b in before.items():
             if n.endswith(".vtu") or n == "summary_si.csv":
-                assert after[n] == b, n                                    # field files never rewritten
-        assert after["summary.csv"].startswith(before["summary.csv"])      # rows appended
+                assert after[n] == b, n  # field files never rewritten
+        assert after["summary.csv"].startswith(before["summary.csv"])  # rows appended
         assert [t for t, _ in _times(folder)] == pytest.approx([0.0, 0.02, 0.04, 0.06, 0.08])

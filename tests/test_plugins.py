@@ -26,22 +26,29 @@ import femehl
 from femehl.core.terms import Contribution, Poiseuille
 from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, Winkler
 
-FE = dict(method="fe", mesh="coarse", linear_solver="lu")   # exact comparisons: direct solves
+FE = dict(method="fe", mesh="coarse", linear_solver="lu")  # exact comparisons: direct solves
 FD = dict(method="fd", dr=0.1, dtheta=math.pi / 12)
 RUN = dict(t_end=1.6, dt=0.04, store_every=10)
 
 
-def paper_like(substrate, beta=200.0, velocity=TanhStart(1.0, 1.0)):
-    return Scene(indenter=Sphere(), substrate=substrate, fluid=Fluid(beta),
-                 motion=Motion(gap=RampHold(0.1, -0.4, 1.0), velocity=velocity),
-                 domain=Domain(2.0))
+SLIDE = TanhStart(1.0, 1.0)
+
+
+def paper_like(substrate, beta=200.0, velocity=SLIDE):
+    return Scene(
+        indenter=Sphere(),
+        substrate=substrate,
+        fluid=Fluid(beta),
+        motion=Motion(gap=RampHold(0.1, -0.4, 1.0), velocity=velocity),
+        domain=Domain(2.0),
+    )
 
 
 def assert_same_run(a, b, rtol):
     for name in ("load", "film_center", "film_min", "p_max", "hc"):
         x, y = getattr(a, name), getattr(b, name)
         assert np.allclose(x, y, rtol=rtol, atol=rtol * np.abs(x).max()), name
-    for s, t in zip(a.states, b.states):
+    for s, t in zip(a.states, b.states, strict=True):
         assert np.allclose(s.d, t.d, rtol=rtol, atol=0)
 
 
@@ -110,7 +117,7 @@ class Viscous:
         self.eta = eta
 
     def value(self, d, p_film=None):
-        return d ** 3 / self.eta
+        return d**3 / self.eta
 
     def d_dd(self, d, p_film=None):
         return 3.0 * d * d / self.eta
@@ -119,8 +126,9 @@ class Viscous:
 @pytest.mark.parametrize("method", [FE, FD], ids=["fe", "fd"])
 def test_new_mobility_equals_rescaled_beta(method):
     """beta div(d^3/eta grad p) is the equation with beta/eta: same run to round-off."""
-    a = femehl.solve(paper_like(HalfSpace(), beta=200.0), **method, **RUN,
-                     terms=[Poiseuille(mobility=Viscous(2.0))])
+    a = femehl.solve(
+        paper_like(HalfSpace(), beta=200.0), **method, **RUN, terms=[Poiseuille(mobility=Viscous(2.0))]
+    )
     b = femehl.solve(paper_like(HalfSpace(), beta=100.0), **method, **RUN)
     assert a.info["terms"] == ["poiseuille", "squeeze", "couette"]
     assert_same_run(a, b, rtol=1e-9)
@@ -169,21 +177,25 @@ def test_new_term_sliding_along_y_is_sliding_along_x_rotated():
     gap = RampHold(0.1, -0.5, 1.0)
     kw = dict(mesh="coarse", half=False, t_end=2.5, dt=0.05, scheme="bdf2", store_every=0)
     rx = femehl.solve(Scene(motion=Motion(gap=gap, velocity=velocity), fluid=Fluid(50.0)), **kw)
-    ry = femehl.solve(Scene(motion=Motion(gap=gap, velocity=0.0), fluid=Fluid(50.0)), **kw,
-                      terms=[TransverseCouette(velocity)])
+    ry = femehl.solve(
+        Scene(motion=Motion(gap=gap, velocity=0.0), fluid=Fluid(50.0)),
+        **kw,
+        terms=[TransverseCouette(velocity)],
+    )
     assert "couette_y" in ry.info["terms"]
     for name, tol in (("load", 5e-5), ("film_center", 1e-3), ("film_min", 1e-2)):
         assert ry.value_at(name, 2.5) == pytest.approx(rx.value_at(name, 2.5), rel=tol), name
     sx, sy = rx.summary(), ry.summary()
-    assert abs(sy["film_min_y"][-1] - sx["film_min_x"][-1]) < 0.1         # exit at y < 0
+    assert abs(sy["film_min_y"][-1] - sx["film_min_x"][-1]) < 0.1  # exit at y < 0
     assert abs(abs(sy["film_min_x"][-1]) - abs(sx["film_min_y"][-1])) < 0.1
     # without the term the y run is pure indentation: its pressure stays symmetric in y
     assert abs(sx["film_min_y"][-1]) > 0.3 and sy["film_min_y"][-1] < -0.5
 
 
 # ---- the registries ---------------------------------------------------------------------------
-@pytest.mark.parametrize("name", sorted(femehl.core.linsolve.LINEAR_SOLVERS)
-                         if hasattr(femehl, "core") else ["lu", "gmres"])
+@pytest.mark.parametrize(
+    "name", sorted(femehl.core.linsolve.LINEAR_SOLVERS) if hasattr(femehl, "core") else ["lu", "gmres"]
+)
 def test_every_linear_solver_solves_the_paper_step(name):
     """Every registered linear solver gives the direct solve's films (rtol 1e-10 per step)."""
     sc = femehl.presets.paper_sphere()
@@ -195,5 +207,4 @@ def test_every_linear_solver_solves_the_paper_step(name):
 
 def test_terms_must_have_distinct_names():
     with pytest.raises(femehl.SceneError, match="distinct"):
-        femehl.make_stepper(femehl.presets.paper_sphere(), mesh="coarse",
-                            terms=[Poiseuille(), Poiseuille()])
+        femehl.make_stepper(femehl.presets.paper_sphere(), mesh="coarse", terms=[Poiseuille(), Poiseuille()])

@@ -406,8 +406,10 @@ def test_compressible_halfspace_deflection_scaling():
     fe = [femehl.make_stepper(Scene(substrate=HalfSpace(nu)), "fe", mesh="coarse") for nu in (0.5, 0.3)]
     p = np.random.default_rng(3).random(fe[0].disc.n)
     assert np.allclose(fe[1].C @ p, 1.4 * (fe[0].C @ p), rtol=1e-14, atol=0)
-    fd = [femehl.make_stepper(Scene(substrate=HalfSpace(nu)), "fd", dr=0.2, dtheta=math.pi / 8)
-          for nu in (0.5, 0.3)]
+    fd = [
+        femehl.make_stepper(Scene(substrate=HalfSpace(nu)), "fd", dr=0.2, dtheta=math.pi / 8)
+        for nu in (0.5, 0.3)
+    ]
     q = np.random.default_rng(4).random(fd[0].disc.n)
     assert np.allclose(fd[1].C @ q, 1.4 * (fd[0].C @ q), rtol=1e-14, atol=0)
     # small deflection: the squeeze pressure hardly depends on the substrate
@@ -599,7 +601,7 @@ def test_cli_writes_si_summary(tmp_path, capsys):
     )
     assert rc == 0
     cap = capsys.readouterr()
-    assert "imposed_load=True" in cap.err          # the run report goes to stderr (logging)
+    assert "imposed_load=True" in cap.err  # the run report goes to stderr (logging)
     with open(out / "summary_si.csv") as fh:
         rows = list(csv.reader(fh))
     assert rows[0][:4] == ["t_s", "hc_m", "load_N", "film_center_m"]

@@ -31,8 +31,14 @@ import pytest
 import femehl
 from femehl import presets
 from femehl.baseline import RelaxationStepper, mass_balance_residual
-from femehl.errors import (CheckpointError, FilmRuptureError, RelaxationDivergedError, SceneError, SingularSystemError,
-                           SolverError)
+from femehl.errors import (
+    CheckpointError,
+    FilmRuptureError,
+    RelaxationDivergedError,
+    SceneError,
+    SingularSystemError,
+    SolverError,
+)
 from femehl.output.checkpoint import load_checkpoint
 from femehl.run import run_to_folder
 from femehl.scene import Domain, Fluid, Motion, RampHold, Rigid, Scene, Sphere
@@ -297,7 +303,7 @@ def test_resume_after_a_run_that_went_past_its_checkpoint(tmp_path):
     for f in ("checkpoint.npz", "checkpoint.json"):
         (a / f).write_bytes((b / f).read_bytes())
     before = {p.name: p.read_bytes() for p in a.glob("fields_*.vtu")}
-    assert len(before) == 4                                   # t = 0, 0.3, 0.6, 0.7
+    assert len(before) == 4  # t = 0, 0.3, 0.6, 0.7
     run_to_folder(sc, a, t_end=0.7, resume=True, **RUN)
     ts = [float(r[0]) for r in _summary_rows(a)[1:]]
     assert ts == pytest.approx([0.1 * k for k in range(8)])

@@ -42,7 +42,9 @@ def test_directory_is_reported_as_directory(tmp_path):
 def test_missing_file_is_reported_as_missing(tmp_path):
     with pytest.raises(MeshError, match=r"nope\.msh' does not exist; pass an existing mesh file"):
         load_mesh(tmp_path / "nope.msh")
-    with pytest.raises(MeshError, match=r"'corse' does not exist \(did you mean the ladder mesh 'coarse'\?\)"):
+    with pytest.raises(
+        MeshError, match=r"'corse' does not exist \(did you mean the ladder mesh 'coarse'\?\)"
+    ):
         load_mesh("corse")
 
 
@@ -58,15 +60,18 @@ def test_unreadable_file(tmp_path):
         p.chmod(0o600)
 
 
-@pytest.mark.parametrize("suffix,data", [
-    (".msh", b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\ngarbage"),
-    (".msh", b""),
-    (".vtu", b"<VTKFile><broken"),
-    (".xdmf", b"\x00\x01\x02\xff" * 50),
-    (".stl", b"solid x\n facet normal nonsense"),
-    (".weird", b"1 2 3\n"),
-    ("", b"no suffix at all"),
-])
+@pytest.mark.parametrize(
+    "suffix,data",
+    [
+        (".msh", b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\ngarbage"),
+        (".msh", b""),
+        (".vtu", b"<VTKFile><broken"),
+        (".xdmf", b"\x00\x01\x02\xff" * 50),
+        (".stl", b"solid x\n facet normal nonsense"),
+        (".weird", b"1 2 3\n"),
+        ("", b"no suffix at all"),
+    ],
+)
 def test_garbage_file_is_not_a_mesh_meshio_can_read(tmp_path, capsys, suffix, data):
     p = tmp_path / f"bad{suffix}"
     p.write_bytes(data)
@@ -95,7 +100,7 @@ def test_machine_memory_reads_sysconf_and_falls_back(monkeypatch):
 
     monkeypatch.setattr(M.os, "sysconf", broken)
     assert machine_memory() is None
-    check_mesh_memory(10**6, 10**6, "huge")       # unknown memory: no refusal (graceful)
+    check_mesh_memory(10**6, 10**6, "huge")  # unknown memory: no refusal (graceful)
 
 
 def test_operator_estimate_is_elements_times_free_nodes_times_8():
@@ -103,18 +108,21 @@ def test_operator_estimate_is_elements_times_free_nodes_times_8():
 
 
 def test_memory_check_names_estimate_and_machine_memory():
-    with pytest.raises(MeshError, match=r"mesh big: 100000 elements and about 50000 free nodes need a dense "
-                                        r"elastic operator of 40 GB.*about 160 GB with the LU working "
-                                        r"copies, more than 60% of this machine's 16 GB"):
+    with pytest.raises(
+        MeshError,
+        match=r"mesh big: 100000 elements and about 50000 free nodes need a dense "
+        r"elastic operator of 40 GB.*about 160 GB with the LU working "
+        r"copies, more than 60% of this machine's 16 GB",
+    ):
         check_mesh_memory(100_000, 50_000, "big", memory=16 * 10**9)
     check_mesh_memory(1000, 500, "small", memory=16 * 10**9)
 
 
 def test_loading_a_mesh_too_big_for_the_machine_is_refused(monkeypatch, tmp_path):
-    medium = load_mesh("medium")                                # loaded before the machine "shrinks"
+    medium = load_mesh("medium")  # loaded before the machine "shrinks"
     p = tmp_path / "copy.msh"
     shutil.copy(M.ladder_path("medium"), p)
-    monkeypatch.setattr(M, "machine_memory", lambda: 10**8)      # a 100 MB machine
+    monkeypatch.setattr(M, "machine_memory", lambda: 10**8)  # a 100 MB machine
     with pytest.raises(MeshError, match=r"mesh medium: 2982 elements .*of this machine's 0\.1 GB"):
         load_mesh("medium")
     with pytest.raises(MeshError, match=rf"mesh {p}: 2982 elements"):
@@ -123,7 +131,7 @@ def test_loading_a_mesh_too_big_for_the_machine_is_refused(monkeypatch, tmp_path
         load_mesh(medium.mesh)
     with pytest.raises(MeshError, match=r"mesh medium: 2982 elements"):
         load_mesh(medium)
-    dm = load_mesh("coarse")         # 1468 x ~770 nodes x 8 x 4 = 36 MB < 60 MB: fits
+    dm = load_mesh("coarse")  # 1468 x ~770 nodes x 8 x 4 = 36 MB < 60 MB: fits
     assert dm.mesh.t.shape[1] == 1468
 
 
@@ -138,16 +146,24 @@ def test_graded_disk_memory_refused_before_gmsh(monkeypatch):
 
 
 # ---- 2e. gmsh sizes that would make millions of elements ----------------------------------
-@pytest.mark.parametrize("sizes", [{"h_far": 1e-4, "h_contact": 1e-4, "h_edge": 1e-4},
-                                   {"h_far": 0.25, "h_contact": 0.05, "h_edge": 1e-9},
-                                   {"h_far": 1e-3, "h_contact": 1e-3, "h_edge": 1e-3}])
+@pytest.mark.parametrize(
+    "sizes",
+    [
+        {"h_far": 1e-4, "h_contact": 1e-4, "h_edge": 1e-4},
+        {"h_far": 0.25, "h_contact": 0.05, "h_edge": 1e-9},
+        {"h_far": 1e-3, "h_contact": 1e-3, "h_edge": 1e-3},
+    ],
+)
 def test_too_many_elements_refused_before_gmsh(monkeypatch, sizes):
     def no_gmsh(*a, **k):
         raise AssertionError("gmsh must not run")
 
     monkeypatch.setattr(M, "_gmsh_disk", no_gmsh)
-    with pytest.raises(MeshError, match=r"would make about [0-9.e+]+ elements, more than 2e\+06.*larger "
-                                        r"mesh sizes"):
+    with pytest.raises(
+        MeshError,
+        match=r"would make about [0-9.e+]+ elements, more than 2e\+06.*larger "
+        r"mesh sizes",
+    ):
         graded_disk(L=2.0, **sizes)
 
 
@@ -167,8 +183,9 @@ def test_element_estimate_scales_as_one_over_size_squared(scale, half):
     """h(r) is homogeneous of degree one in the sizes: s times the sizes, 1/s^2 the elements."""
     kw = LADDER["coarse"]
     h1 = M._size_function(2.0, kw["h_far"], kw["h_contact"], kw["h_edge"], kw["r_contact"], kw["r_edge"])
-    hs = M._size_function(2.0, scale * kw["h_far"], scale * kw["h_contact"], scale * kw["h_edge"],
-                          kw["r_contact"], kw["r_edge"])
+    hs = M._size_function(
+        2.0, scale * kw["h_far"], scale * kw["h_contact"], scale * kw["h_edge"], kw["r_contact"], kw["r_edge"]
+    )
     e1, es = estimate_elements(2.0, half, h1), estimate_elements(2.0, half, hs)
     assert es == pytest.approx(e1 / scale**2, rel=1e-9)
 
@@ -193,7 +210,7 @@ def test_scene_file_mesh_relative_to_scene_file(tmp_path, monkeypatch):
     (sub / "m").mkdir(parents=True)
     shutil.copy(M.ladder_path("coarse"), sub / "m" / "disk.msh")
     (sub / "s.toml").write_text('[run]\nmesh = "m/disk.msh"\n', encoding="utf-8")
-    monkeypatch.chdir(tmp_path)                          # not the scene file's folder
+    monkeypatch.chdir(tmp_path)  # not the scene file's folder
     _, run = load_scene_file("case/s.toml")
     dm = load_mesh(run["mesh"], L=2.0)
     assert dm.mesh.t.shape[1] == 1468 and dm.half

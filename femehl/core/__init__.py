@@ -14,5 +14,11 @@ from .linsolve import LINEAR_SOLVERS, register_linear_solver
 from .stepper import LaggedStepper
 from .terms import TERMS, Contribution, register_term
 
-__all__ = ["LaggedStepper", "TERMS", "register_term", "Contribution", "LINEAR_SOLVERS",
-           "register_linear_solver"]
+__all__ = [
+    "LaggedStepper",
+    "TERMS",
+    "register_term",
+    "Contribution",
+    "LINEAR_SOLVERS",
+    "register_linear_solver",
+]

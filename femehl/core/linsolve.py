@@ -38,7 +38,7 @@ All state (the factor, the recycled directions, the cost of one iteration, count
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -47,8 +47,14 @@ import scipy.sparse.linalg as spla
 
 from ..errors import SceneError, SingularSystemError
 
-__all__ = ["StepOperator", "LINEAR_SOLVERS", "register_linear_solver", "DirectSolver",
-           "RecycledGCR", "make_linear_solver"]
+__all__ = [
+    "StepOperator",
+    "LINEAR_SOLVERS",
+    "register_linear_solver",
+    "DirectSolver",
+    "RecycledGCR",
+    "make_linear_solver",
+]
 
 
 @dataclass
@@ -117,10 +123,12 @@ LINEAR_SOLVERS: dict[str, type] = {}
 
 def register_linear_solver(name: str):
     """Class decorator adding a linear solver to :data:`LINEAR_SOLVERS`."""
+
     def deco(cls):
         cls.name = name
         LINEAR_SOLVERS[name] = cls
         return cls
+
     return deco
 
 
@@ -131,8 +139,9 @@ def make_linear_solver(name, **options):
 
 
 def _singular(t, what):
-    return SingularSystemError(f"step at t = {t:.6g}: {what}. Try a smaller dt or a finer "
-                               "discretization.", t=t)
+    return SingularSystemError(
+        f"step at t = {t:.6g}: {what}. Try a smaller dt or a finer discretization.", t=t
+    )
 
 
 def _dense_lu(A, t):
@@ -159,7 +168,7 @@ class DirectSolver:
 
     def __init__(self):
         self.info = {"factorizations": 0, "factor_s": 0.0}
-        self.residuals: list = []       # relative true residuals of the last step (where cheap)
+        self.residuals: list = []  # relative true residuals of the last step (where cheap)
 
     def factor(self, op: StepOperator, t: float):
         t0 = time.perf_counter()
@@ -172,10 +181,11 @@ class DirectSolver:
             A = op.matrix()
             lu = _sparse_lu(A, t)
 
-            def solve(b):             # sparse: the true residual costs nothing, record it
+            def solve(b):  # sparse: the true residual costs nothing, record it
                 x = lu.solve(b)
                 self.residuals.append(float(np.linalg.norm(A @ x - b) / np.linalg.norm(b)))
                 return x
+
         self.info["factorizations"] += 1
         self.info["factor_s"] += time.perf_counter() - t0
         return solve
@@ -196,11 +206,11 @@ class DirectSolver:
 
 @dataclass
 class _Factor:
-    lu: tuple           # LAPACK LU of A^T (A C-ordered = A^T Fortran-ordered: no copy)
-    key: float          # op.key of the factorized matrix
-    total: float        # cost of this factor's cycle: factorization + preconditioned iterations
-    solves: int = 0     # solves of this cycle
-    stale: bool = False # refresh at the next solve
+    lu: tuple  # LAPACK LU of A^T (A C-ordered = A^T Fortran-ordered: no copy)
+    key: float  # op.key of the factorized matrix
+    total: float  # cost of this factor's cycle: factorization + preconditioned iterations
+    solves: int = 0  # solves of this cycle
+    stale: bool = False  # refresh at the next solve
 
 
 @register_linear_solver("gmres")
@@ -220,16 +230,18 @@ class RecycledGCR:
         Preconditioned iterations before falling back to a direct solve.
     """
 
-    def __init__(self, rtol: float = 1e-8, refactor_after: int | None = None, recycle: int = 8,
-                 max_krylov: int = 30):
+    def __init__(
+        self, rtol: float = 1e-8, refactor_after: int | None = None, recycle: int = 8, max_krylov: int = 30
+    ):
         try:
             rtol = float(rtol)
         except (TypeError, ValueError):
             rtol = float("nan")
         if not (0.0 < rtol < 1e-2):
             raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
-        if refactor_after is not None and (isinstance(refactor_after, bool)
-                                           or not isinstance(refactor_after, int) or refactor_after < 1):
+        if refactor_after is not None and (
+            isinstance(refactor_after, bool) or not isinstance(refactor_after, int) or refactor_after < 1
+        ):
             raise SceneError(f"refactor_after must be an integer >= 1 or None, got {refactor_after!r}.")
         if isinstance(recycle, bool) or not isinstance(recycle, int) or recycle < 0:
             raise SceneError(f"recycle must be an integer >= 0, got {recycle!r}.")
@@ -237,20 +249,20 @@ class RecycledGCR:
         self.refactor_after = refactor_after
         self.recycle = recycle
         self.max_krylov = max_krylov
-        self.precond_dtype = np.float32     # the LU is a preconditioner only: single precision
+        self.precond_dtype = np.float32  # the LU is a preconditioner only: single precision
         self.direct = DirectSolver()
         self.factor: _Factor | None = None
-        self.solutions: list = []           # recent (x, C x)
-        self.directions: list = []          # recent preconditioned (z, C z)
-        self.t_iter = 0.0                   # wall time of one preconditioned iteration (s)
-        self.history: list = []             # relative residuals of the last solve
+        self.solutions: list = []  # recent (x, C x)
+        self.directions: list = []  # recent preconditioned (z, C z)
+        self.t_iter = 0.0  # wall time of one preconditioned iteration (s)
+        self.history: list = []  # relative residuals of the last solve
         self.info = {"factorizations": 0, "factor_s": 0.0, "krylov_iterations": 0, "krylov_s": 0.0}
-        self._own_factorizations = 0        # preconditioner LUs (the direct fallback counts its own)
+        self._own_factorizations = 0  # preconditioner LUs (the direct fallback counts its own)
         self._own_factor_s = 0.0
 
     def solve(self, op: StepOperator, rhs: list, t: float) -> list:
         self.residuals = []
-        if not op.dense:                      # nothing dense to save: solve directly
+        if not op.dense:  # nothing dense to save: solve directly
             out = self.direct.solve(op, rhs, t)
             self.residuals = self.direct.residuals
             self._sync()
@@ -275,7 +287,7 @@ class RecycledGCR:
         self.info["krylov_iterations"] += its
         self.info["krylov_s"] += time.perf_counter() - t0
         if x is None:
-            if fresh:        # even a fresh preconditioner failed: solve directly in double
+            if fresh:  # even a fresh preconditioner failed: solve directly in double
                 x = self.direct.solve(op, [b], t)[0][0]
                 self._sync()
                 return x, None
@@ -293,7 +305,7 @@ class RecycledGCR:
 
     def _refactor(self, op, t):
         """Single-precision LU of the current A, the preconditioner (in place)."""
-        self.factor = None                  # free the old factor before forming the new A
+        self.factor = None  # free the old factor before forming the new A
         t0 = time.perf_counter()
         lu = _dense_lu(op.matrix(dtype=self.precond_dtype), t)
         cost = time.perf_counter() - t0
@@ -305,8 +317,9 @@ class RecycledGCR:
 
     def _precondition(self, r):
         lu = self.factor.lu
-        return sla.lu_solve(lu, r.astype(lu[0].dtype, copy=False), trans=1,
-                            check_finite=False).astype(np.float64, copy=False)
+        return sla.lu_solve(lu, r.astype(lu[0].dtype, copy=False), trans=1, check_finite=False).astype(
+            np.float64, copy=False
+        )
 
     def _krylov(self, op, G, b, bnorm, f):
         """Minimal residual over recycled + preconditioned directions.
@@ -319,9 +332,9 @@ class RecycledGCR:
         rec = self.solutions + self.directions
         m = len(rec) + self.max_krylov
         n, ne = b.size, C.shape[0]
-        Z = np.empty((m, n))            # row j: direction z_j
-        CZ = np.empty((m, ne))          # row j: C z_j
-        Q = np.empty((m, n))            # row j: orthonormal basis of A span(Z)
+        Z = np.empty((m, n))  # row j: direction z_j
+        CZ = np.empty((m, ne))  # row j: C z_j
+        Q = np.empty((m, n))  # row j: orthonormal basis of A span(Z)
         R = np.zeros((m, m))
         g = np.zeros(m)
         k = 0
@@ -329,7 +342,7 @@ class RecycledGCR:
         if rec:
             Zr = np.array([z for z, _ in rec])
             CZr = np.array([cz for _, cz in rec])
-            AZ = op.apply(Zr.T, CZr.T, G)                      # sparse work only
+            AZ = op.apply(Zr.T, CZr.T, G)  # sparse work only
             scale = np.linalg.norm(AZ, axis=0)
             scale[scale == 0.0] = 1.0
             q, rr, piv = sla.qr(AZ / scale, mode="economic", pivoting=True)
@@ -340,7 +353,7 @@ class RecycledGCR:
             CZ[:k] = CZr[sel] / scale[sel, None]
             Q[:k] = q[:, :k].T
             R[:k, :k] = rr[:k, :k]
-            for _ in range(2):                      # r = b - Q Q^T b, reorthogonalized
+            for _ in range(2):  # r = b - Q Q^T b, reorthogonalized
                 h = Q[:k] @ r
                 r -= h @ Q[:k]
                 g[:k] += h
@@ -353,8 +366,8 @@ class RecycledGCR:
                     return None, None, its, []
                 y = sla.solve_triangular(R[:k, :k], g[:k])
                 x = y @ Z[:k]
-                Cx = C @ x                                      # exact, for the state and the check
-                rt = b - D @ x - G @ Cx                         # the TRUE residual
+                Cx = C @ x  # exact, for the state and the check
+                rt = b - D @ x - G @ Cx  # the TRUE residual
                 res = float(np.linalg.norm(rt))
                 hist.append(res / bnorm)
                 self.history = hist
@@ -363,10 +376,10 @@ class RecycledGCR:
                     return x, Cx, its, [(Z[j].copy(), CZ[j].copy()) for j in range(k_rec, k)]
                 if its >= self.max_krylov or not np.isfinite(res):
                     return None, None, its, []
-                r = rt - (Q[:k] @ rt) @ Q[:k]          # continue from the true residual
+                r = rt - (Q[:k] @ rt) @ Q[:k]  # continue from the true residual
             t0 = time.perf_counter()
             z = self._precondition(r)
-            cz = C @ z                                          # the one dense product
+            cz = C @ z  # the one dense product
             q = D @ z + G @ cz
             h = np.zeros(k)
             for _ in range(2):
@@ -394,4 +407,4 @@ class RecycledGCR:
             return
         nsol = min(4, self.recycle)
         self.solutions = ([(x, Cx)] + self.solutions)[:nsol]
-        self.directions = (dirs + self.directions)[:max(0, self.recycle - len(self.solutions))]
+        self.directions = (dirs + self.directions)[: max(0, self.recycle - len(self.solutions))]

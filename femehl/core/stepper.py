@@ -35,7 +35,7 @@ from .terms import StepContext, terms_for
 
 __all__ = ["LaggedStepper"]
 
-_PROBE_FRACTION = 0.5     # nodes whose estimated film is below this x the film minimum are checked exactly
+_PROBE_FRACTION = 0.5  # nodes whose estimated film is below this x the film minimum are checked exactly
 _MAX_PROBES = 64
 
 
@@ -68,8 +68,9 @@ class LaggedStepper:
         Options of the linear solver (``rtol``, ``refactor_after``, ``recycle``).
     """
 
-    def __init__(self, disc, scheme: str = "euler", linear_solver: str | None = None, terms=(),
-                 **solver_options):
+    def __init__(
+        self, disc, scheme: str = "euler", linear_solver: str | None = None, terms=(), **solver_options
+    ):
         t0 = time.perf_counter()
         scene = disc.scene
         self.scene = scene
@@ -98,13 +99,21 @@ class LaggedStepper:
         self.g = disc.load_weights
         self._FC: dict[str, object] = {}
         self.info = dict(disc.info)
-        self.info.update({
-            "method": self.method, "scheme": self.scheme.name, "substrate": type(substrate).__name__,
-            "linear_solver": name, "terms": [t.name for t in self.terms],
-            "elastic_build_s": t2 - t1, "operator_bytes": int(_nbytes(self.C)),
-            "couette_assembled": False, "factorizations": 0, "krylov_iterations": 0,
-        })
-        for term in self.terms:       # the film products every step needs are formed once
+        self.info.update(
+            {
+                "method": self.method,
+                "scheme": self.scheme.name,
+                "substrate": type(substrate).__name__,
+                "linear_solver": name,
+                "terms": [t.name for t in self.terms],
+                "elastic_build_s": t2 - t1,
+                "operator_bytes": int(_nbytes(self.C)),
+                "couette_assembled": False,
+                "factorizations": 0,
+                "krylov_iterations": 0,
+            }
+        )
+        for term in self.terms:  # the film products every step needs are formed once
             if term.name == "squeeze":
                 self._film_product(term)
         self.info["setup_s"] = disc.info.get("setup_s", 0.0) + time.perf_counter() - t0
@@ -151,11 +160,24 @@ class LaggedStepper:
         i_max = int(np.argmax(p_full))
         info = dict(info or {})
         info.update(self._probe(hc, p, Cp, float(d[i_min])))
-        return State(step=step, t=t, hc=hc, V=V, p=p_full, w=w, d=d, load=float(self.g @ p),
-                     film_center=hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0]), film_min=float(d[i_min]),
-                     film_min_at=tuple(float(v) for v in disc.film_points[i_min]),
-                     p_max=float(p_full[i_max]), p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
-                     info=info, d_prev=d_prev, dt_prev=dt_prev)
+        return State(
+            step=step,
+            t=t,
+            hc=hc,
+            V=V,
+            p=p_full,
+            w=w,
+            d=d,
+            load=float(self.g @ p),
+            film_center=hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0]),
+            film_min=float(d[i_min]),
+            film_min_at=tuple(float(v) for v in disc.film_points[i_min]),
+            p_max=float(p_full[i_max]),
+            p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
+            info=info,
+            d_prev=d_prev,
+            dt_prev=dt_prev,
+        )
 
     def _probe(self, hc, p, Cp, d_min):
         """The film at the nodes whose estimated film is thin, computed exactly."""
@@ -186,13 +208,14 @@ class LaggedStepper:
         a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
         if l1 == 0.0:
             d_lag, hist = state.d, state.d
-        else:       # extrapolated coefficient, kept positive
+        else:  # extrapolated coefficient, kept positive
             d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
             hist = a1 * state.d - a2 * state.d_prev
         p_old = state.p[self.disc.free_index]
         its0 = self.solver.info.get("krylov_iterations", 0)
-        ctx = StepContext(t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old,
-                          V=V, beta=self.beta)
+        ctx = StepContext(
+            t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
+        )
         op, rhs = self.operator(ctx)
         G = op.G()
         if mo.load_controlled:
@@ -201,8 +224,10 @@ class LaggedStepper:
             (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ self.shape, G @ ones], t_new)
             den = float(self.g @ x2)
             if not np.isfinite(den) or den == 0.0:
-                raise SingularSystemError(f"step at t = {t_new:.6g}: the load row is singular "
-                                          "(the film does not respond to hc).", t=t_new)
+                raise SingularSystemError(
+                    f"step at t = {t_new:.6g}: the load row is singular (the film does not respond to hc).",
+                    t=t_new,
+                )
             hc = (float(self.g @ x1) - F) / den
             p = x1 - hc * x2
             Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
@@ -212,7 +237,9 @@ class LaggedStepper:
         if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
-                "or ill-conditioned. Try a smaller dt or a finer discretization.", t=t_new)
+                "or ill-conditioned. Try a smaller dt or a finer discretization.",
+                t=t_new,
+            )
         self.info.update(self.solver.info)
         info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
         if self.solver.residuals:

@@ -31,8 +31,19 @@ import numpy as np
 
 from ..errors import SceneError
 
-__all__ = ["Contribution", "StepContext", "Term", "TERMS", "register_term", "terms_for",
-           "Squeeze", "Couette", "Poiseuille", "Mobility", "Newtonian"]
+__all__ = [
+    "Contribution",
+    "StepContext",
+    "Term",
+    "TERMS",
+    "register_term",
+    "terms_for",
+    "Squeeze",
+    "Couette",
+    "Poiseuille",
+    "Mobility",
+    "Newtonian",
+]
 
 
 @dataclass(frozen=True)
@@ -63,9 +74,9 @@ class Contribution:
     film points); the stepper forms ``F C`` once per term name.
     """
 
-    matrix: object = None              # sparse (n, n) acting on p
-    film_coefficient: float = 0.0      # multiplies F d^{k+1}
-    rhs: np.ndarray | None = None      # added to the right-hand side
+    matrix: object = None  # sparse (n, n) acting on p
+    film_coefficient: float = 0.0  # multiplies F d^{k+1}
+    rhs: np.ndarray | None = None  # added to the right-hand side
 
 
 class Term(Protocol):
@@ -101,8 +112,11 @@ def terms_for(scene, t_end=None, extra=()) -> list:
     names = [t.name for t in extra]
     if len(set(names)) != len(names):
         raise SceneError(f"terms must have distinct names, got {names}.")
-    out = [next(t for t in extra if t.name == name) if name in names else cls()
-           for name, cls in TERMS.items() if cls.applies(scene, t_end)]
+    out = [
+        next(t for t in extra if t.name == name) if name in names else cls()
+        for name, cls in TERMS.items()
+        if cls.applies(scene, t_end)
+    ]
     return out + [t for t in extra if t.name not in TERMS]
 
 
@@ -119,7 +133,7 @@ class Newtonian:
     """``m = d^3``: a Newtonian film with no slip (the paper's Eq. 8)."""
 
     def value(self, d, p_film=None):
-        return d ** 3
+        return d**3
 
     def d_dd(self, d, p_film=None):
         return 3.0 * d * d
@@ -156,7 +170,7 @@ class Squeeze:
 
     @staticmethod
     def applies(scene, t_end=None):
-        return True      # the film's own time derivative is always there (w changes with p)
+        return True  # the film's own time derivative is always there (w changes with p)
 
     def setup(self, disc):
         self.T = disc.squeeze()
@@ -176,7 +190,7 @@ class Couette:
 
     @staticmethod
     def applies(scene, t_end=None):
-        return True          # assembled only the first time V(t) != 0
+        return True  # assembled only the first time V(t) != 0
 
     def setup(self, disc):
         self.disc = disc

@@ -39,10 +39,12 @@ METHODS: dict[str, type] = {}
 
 def register_method(name: str):
     """Class decorator adding a discretization to :data:`METHODS` under ``name``."""
+
     def deco(cls):
         cls.method = name
         METHODS[name] = cls
         return cls
+
     return deco
 
 

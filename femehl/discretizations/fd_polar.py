@@ -66,9 +66,9 @@ def _expansion(grid: PolarGrid):
     fj = np.arange(1, n - 1)
     nfree = fi.size * fj.size
     I, J = np.meshgrid(np.arange(m), np.arange(n), indexing="ij")
-    src_i = np.clip(I, 1, m - 2)              # mirror rows theta = 0, pi (Eq. 17b)
-    src_j = np.maximum(J, 1)                  # centre p_{i,0} = p_{i,1}  (Eq. 17a)
-    keep = (J < n - 1).ravel()                # p = 0 on r = L            (Eq. 18a)
+    src_i = np.clip(I, 1, m - 2)  # mirror rows theta = 0, pi (Eq. 17b)
+    src_j = np.maximum(J, 1)  # centre p_{i,0} = p_{i,1}  (Eq. 17a)
+    keep = (J < n - 1).ravel()  # p = 0 on r = L            (Eq. 18a)
     rows = np.arange(m * n)[keep]
     cols = ((src_i - 1) * (n - 2) + (src_j - 1)).ravel()[keep]
     E = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(m * n, nfree))
@@ -82,10 +82,12 @@ def _forward_diff(grid: PolarGrid, rows):
     k = rows.size
     ar = np.arange(k)
     one = np.ones(k)
-    Dr = sp.csr_matrix((np.r_[one, -one] / grid.dr, (np.r_[ar, ar], np.r_[rows + 1, rows])),
-                       shape=(k, grid.m * n))
-    Dt = sp.csr_matrix((np.r_[one, -one] / grid.dtheta, (np.r_[ar, ar], np.r_[rows + n, rows])),
-                       shape=(k, grid.m * n))
+    Dr = sp.csr_matrix(
+        (np.r_[one, -one] / grid.dr, (np.r_[ar, ar], np.r_[rows + 1, rows])), shape=(k, grid.m * n)
+    )
+    Dt = sp.csr_matrix(
+        (np.r_[one, -one] / grid.dtheta, (np.r_[ar, ar], np.r_[rows + n, rows])), shape=(k, grid.m * n)
+    )
     return Dr, Dt
 
 
@@ -113,7 +115,8 @@ class FDDisc:
             raise SceneError(
                 "the FD solver computes the half plane y >= 0 and mirrors it (paper Eq. 17b), so "
                 f"it needs an indenter symmetric in y; {type(scene.indenter).__name__} is not. "
-                "Use method='fe' (it meshes the full disk for such shapes).")
+                "Use method='fe' (it meshes the full disk for such shapes)."
+            )
         self.scene = scene
         self.grid = grid = PolarGrid(scene.domain.L, dr, dtheta)
         m, n = grid.m, grid.n
@@ -125,17 +128,26 @@ class FDDisc:
         self.theta = th.ravel()
         self.nodes = self.film_points = grid.xy()
         self.shape = self.gap(self.nodes)
-        self.node_average = None            # the film points are the nodes
+        self.node_average = None  # the film points are the nodes
         self.area = grid.cell_areas().ravel()
-        self.load_weights = 2.0 * (self.E.T @ self.area)       # whole plane
+        self.load_weights = 2.0 * (self.E.T @ self.area)  # whole plane
         Dr, Dt = _forward_diff(grid, self.rows)
         ri = self.r[self.rows]
-        self._G = (sp.diags(np.cos(self.theta[self.rows])) @ Dr
-                   - sp.diags(np.sin(self.theta[self.rows]) / ri) @ Dt).tocsr()
-        self._S = sp.csr_matrix((np.ones(self.rows.size), (np.arange(self.rows.size), self.rows)),
-                                shape=(self.rows.size, m * n))
-        self.info = {"dr": grid.dr, "dtheta": grid.dtheta, "m": m, "n": n, "nodes": m * n,
-                     "unknowns": self.n, "setup_s": time.perf_counter() - t0}
+        self._G = (
+            sp.diags(np.cos(self.theta[self.rows])) @ Dr - sp.diags(np.sin(self.theta[self.rows]) / ri) @ Dt
+        ).tocsr()
+        self._S = sp.csr_matrix(
+            (np.ones(self.rows.size), (np.arange(self.rows.size), self.rows)), shape=(self.rows.size, m * n)
+        )
+        self.info = {
+            "dr": grid.dr,
+            "dtheta": grid.dtheta,
+            "m": m,
+            "n": n,
+            "nodes": m * n,
+            "unknowns": self.n,
+            "setup_s": time.perf_counter() - t0,
+        }
 
     def gap(self, points):
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -159,10 +171,10 @@ class FDDisc:
         rows = self.rows
         r = self.r[rows]
         mm = m[rows]
-        N = mm / r + dm_dd[rows] * d_r.ravel()[rows]            # Eq. 13b
+        N = mm / r + dm_dd[rows] * d_r.ravel()[rows]  # Eq. 13b
         M = dm_dd[rows] * d_t.ravel()[rows]
-        cr2 = 1.0 / g.dr ** 2
-        ct2 = 1.0 / (r * r * g.dtheta ** 2)
+        cr2 = 1.0 / g.dr**2
+        ct2 = 1.0 / (r * r * g.dtheta**2)
         c_jp = N / g.dr + mm * cr2
         c_jm = mm * cr2
         c_ip = mm * ct2 + M / (r * r * g.dtheta)
@@ -171,9 +183,12 @@ class FDDisc:
         k = rows.size
         ar = np.arange(k)
         Lfull = sp.csr_matrix(
-            (-np.concatenate([c_0, c_jp, c_jm, c_ip, c_im]),
-             (np.tile(ar, 5), np.concatenate([rows, rows + 1, rows - 1, rows + n, rows - n]))),
-            shape=(k, nm * n))
+            (
+                -np.concatenate([c_0, c_jp, c_jm, c_ip, c_im]),
+                (np.tile(ar, 5), np.concatenate([rows, rows + 1, rows - 1, rows + n, rows - n])),
+            ),
+            shape=(k, nm * n),
+        )
         return (Lfull @ self.E).tocsr()
 
     def couette(self):
@@ -199,7 +214,9 @@ class FDDisc:
         j = np.minimum(np.floor(v).astype(int), g.n - 2)
         a, b = u - i, v - j
         rows = np.repeat(inside, 4)
-        cols = np.column_stack([i * g.n + j, i * g.n + j + 1, (i + 1) * g.n + j, (i + 1) * g.n + j + 1]).ravel()
+        cols = np.column_stack(
+            [i * g.n + j, i * g.n + j + 1, (i + 1) * g.n + j, (i + 1) * g.n + j + 1]
+        ).ravel()
         vals = np.column_stack([(1 - a) * (1 - b), (1 - a) * b, a * (1 - b), a * b]).ravel()
         return sp.csr_matrix((vals, (rows, cols)), shape=(pts.shape[0], g.m * g.n))
 

@@ -60,12 +60,15 @@ class FEDisc:
         if half is None:
             half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
         if half and not symmetric:
-            raise SceneError("a half-disk mesh needs an indenter symmetric in y; use half=False "
-                             "or a full-disk mesh.")
+            raise SceneError(
+                "a half-disk mesh needs an indenter symmetric in y; use half=False or a full-disk mesh."
+            )
         dm = load_mesh(mesh, L=scene.domain.L, half=half)
         if dm.half and not symmetric:
-            raise SceneError(f"mesh {dm.name!r} is a half disk but the indenter is not symmetric "
-                             "in y: use a full-disk mesh.")
+            raise SceneError(
+                f"mesh {dm.name!r} is a half disk but the indenter is not symmetric "
+                "in y: use a full-disk mesh."
+            )
         self.dm = dm
         self.mesh = dm.mesh
         self.half = dm.half
@@ -74,14 +77,15 @@ class FEDisc:
         self.basis0 = b0 = b1.with_element(ElementTriP0())
         p, t = self.mesh.p, self.mesh.t
         self.nodes = p.T.copy()
-        self.tri = np.transpose(p[:, t], (2, 1, 0))            # (ne, 3, 2)
+        self.tri = np.transpose(p[:, t], (2, 1, 0))  # (ne, 3, 2)
         self.centroids = centroids(dm)
         self.film_points = self.centroids
         self.areas = areas(dm)
         ne, nn = t.shape[1], p.shape[1]
         # element average of a P1 field: (P p)_e = mean of its 3 nodal values
-        self.P = sp.csr_matrix((np.full(3 * ne, 1.0 / 3.0),
-                                (np.repeat(np.arange(ne), 3), t.T.ravel())), shape=(ne, nn))
+        self.P = sp.csr_matrix(
+            (np.full(3 * ne, 1.0 / 3.0), (np.repeat(np.arange(ne), 3), t.T.ravel())), shape=(ne, nn)
+        )
         r = np.hypot(p[0], p[1])
         self.free = np.flatnonzero(r < self.L * (1.0 - 1e-9))
         self.free_index = self.free
@@ -94,15 +98,21 @@ class FEDisc:
         # element stiffness with unit coefficient; K(m) scales each element by m
         kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(ne)))
         self._k_rows, self._k_cols = kcoo.indices
-        self._k_data = kcoo.data.reshape(-1, ne)                   # (9, ne), element last
+        self._k_data = kcoo.data.reshape(-1, ne)  # (9, ne), element last
         Mfull = asm(squeeze, b0, b1).tocsr()
         self._M = Mfull[self.free]
         mult = 2.0 if self.half else 1.0
-        self.node_weight = np.asarray(Mfull.sum(axis=1)).ravel()   # int phi_q dA
+        self.node_weight = np.asarray(Mfull.sum(axis=1)).ravel()  # int phi_q dA
         self.load_weights = mult * self.node_weight[self.free]
         self._finder_ = None
-        self.info = {"mesh": dm.name, "half": dm.half, "elements": ne, "nodes": nn,
-                     "unknowns": self.n, "setup_s": time.perf_counter() - t0}
+        self.info = {
+            "mesh": dm.name,
+            "half": dm.half,
+            "elements": ne,
+            "nodes": nn,
+            "unknowns": self.n,
+            "setup_s": time.perf_counter() - t0,
+        }
 
     # ---- geometry ------------------------------------------------------------------------
     @property
@@ -117,8 +127,10 @@ class FEDisc:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         s = np.asarray(self.scene.indenter.gap(pts[:, 0], pts[:, 1]), dtype=float)
         if s.shape != (pts.shape[0],) or not np.all(np.isfinite(s)):
-            raise SceneError("the indenter's gap(x, y) must return finite values of the same shape "
-                             "as x; check the shape function.")
+            raise SceneError(
+                "the indenter's gap(x, y) must return finite values of the same shape "
+                "as x; check the shape function."
+            )
         return s
 
     def expand(self, p_free):
@@ -149,6 +161,7 @@ class FEDisc:
     def _locate(self, points):
         if self._finder_ is None:
             import matplotlib.tri as mtri
+
             self._tri = mtri.Triangulation(self.mesh.p[0], self.mesh.p[1], self.mesh.t.T)
             self._finder_ = self._tri.get_trifinder()
         pts = np.asarray(points, dtype=float).reshape(-1, 2).copy()
@@ -160,9 +173,9 @@ class FEDisc:
         """Sparse rows of the P1 interpolation at ``points`` (0 outside the mesh)."""
         pts, e = self._locate(points)
         ok = np.flatnonzero(e >= 0)
-        nodes = self.mesh.t[:, e[ok]].T                       # (k, 3)
-        X = self.nodes[nodes]                                 # (k, 3, 2)
-        T = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=-1)   # (k, 2, 2)
+        nodes = self.mesh.t[:, e[ok]].T  # (k, 3)
+        X = self.nodes[nodes]  # (k, 3, 2)
+        T = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=-1)  # (k, 2, 2)
         lam = np.linalg.solve(T, (pts[ok] - X[:, 0])[..., None])[..., 0] if ok.size else np.zeros((0, 2))
         bary = np.column_stack([1.0 - lam.sum(axis=1), lam])
         rows, cols, vals = np.repeat(ok, 3), nodes.ravel(), bary.ravel()
@@ -178,7 +191,7 @@ class FEDisc:
         """
         ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
-        SP = (S @ self.P[:, self.free]).tocsc()             # (nedges, nfree), sparse
+        SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse
         mirror = self.nodes * np.array([1.0, -1.0])
         C = np.empty((ne, self.n))
         block = max(1, int(2**26 // (8 * edges.shape[0])))

@@ -52,8 +52,10 @@ class LineDisc:
 
         t0 = time.perf_counter()
         if not isinstance(scene, LineScene):
-            raise SceneError(f"method 'line' needs a femehl.line.LineScene, got {type(scene).__name__}: "
-                             "use method 'fe' or 'fd' for a 2-D scene.")
+            raise SceneError(
+                f"method 'line' needs a femehl.line.LineScene, got {type(scene).__name__}: "
+                "use method 'fe' or 'fd' for a 2-D scene."
+            )
         self.scene = scene
         if fine is None and not isinstance(grading, str):
             a = scene.contact_halfwidth()
@@ -70,8 +72,9 @@ class LineDisc:
         self.L = scene.L
         self.nodes = np.column_stack([self.x, np.zeros(nn)])
         self.film_points = np.column_stack([self.xc, np.zeros(ne)])
-        self.P = sp.csr_matrix((np.full(2 * ne, 0.5), (np.repeat(np.arange(ne), 2), t.T.ravel())),
-                               shape=(ne, nn))
+        self.P = sp.csr_matrix(
+            (np.full(2 * ne, 0.5), (np.repeat(np.arange(ne), 2), t.T.ravel())), shape=(ne, nn)
+        )
         self.free = np.setdiff1d(np.arange(nn), self.mesh.boundary_nodes())
         self.free_index = self.free
         self.n = int(self.free.size)
@@ -84,12 +87,18 @@ class LineDisc:
         self._k_data = kcoo.data.reshape(-1, ne)
         Mall = asm(squeeze, b0, b1).tocsr()
         self._M = Mall[self.free]
-        self.node_weight = np.asarray(Mall.sum(axis=1)).ravel()    # int phi_q dx
+        self.node_weight = np.asarray(Mall.sum(axis=1)).ravel()  # int phi_q dx
         self.load_weights = self.node_weight[self.free]
-        self.info = {"elements": ne, "nodes": nn, "unknowns": self.n,
-                     "grading": grading if not callable(grading) else "callable",
-                     "h_min": float(np.diff(self.x).min()), "h_max": float(np.diff(self.x).max()),
-                     "imposed_load": scene.imposed_load, "setup_s": time.perf_counter() - t0}
+        self.info = {
+            "elements": ne,
+            "nodes": nn,
+            "unknowns": self.n,
+            "grading": grading if not callable(grading) else "callable",
+            "h_min": float(np.diff(self.x).min()),
+            "h_max": float(np.diff(self.x).max()),
+            "imposed_load": scene.imposed_load,
+            "setup_s": time.perf_counter() - t0,
+        }
 
     def gap(self, points):
         return self.scene.shape(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0])
@@ -122,13 +131,16 @@ class LineDisc:
         inside = np.flatnonzero(np.abs(xq) <= self.L)
         j = np.clip(np.searchsorted(self.x, xq[inside]) - 1, 0, self.nnodes - 2)
         a = (xq[inside] - self.x[j]) / (self.x[j + 1] - self.x[j])
-        R = sp.csr_matrix((np.r_[1.0 - a, a], (np.r_[inside, inside], np.r_[j, j + 1])),
-                          shape=(xq.size, self.nnodes))
+        R = sp.csr_matrix(
+            (np.r_[1.0 - a, a], (np.r_[inside, inside], np.r_[j, j + 1])), shape=(xq.size, self.nnodes)
+        )
         return R[:, self.free]
 
     def boussinesq(self):
-        raise SceneError("line contact has no half-space operator: the cylinder's plane-strain "
-                         "deflection is not modeled here; use a Winkler (or rigid) substrate.")
+        raise SceneError(
+            "line contact has no half-space operator: the cylinder's plane-strain "
+            "deflection is not modeled here; use a Winkler (or rigid) substrate."
+        )
 
     def boussinesq_rows(self, points):
         return self.boussinesq()

@@ -38,9 +38,15 @@ class PolarGrid:
         nr = self.L / self.dr
         nt = math.pi / self.dtheta
         if abs(nr - round(nr)) > 1e-6 * nr or round(nr) < 4:
-            raise SceneError(f"L/dr = {nr:.6g} must be an integer >= 4: pick dr = L/n, e.g. {self.L / max(4, round(nr)):g}.")
+            raise SceneError(
+                f"L/dr = {nr:.6g} must be an integer >= 4: pick dr = L/n, "
+                f"e.g. {self.L / max(4, round(nr)):g}."
+            )
         if abs(nt - round(nt)) > 1e-6 * nt or round(nt) < 2:
-            raise SceneError(f"pi/dtheta = {nt:.6g} must be an integer >= 2: pick dtheta = pi/n, e.g. pi/{max(2, round(nt))}.")
+            raise SceneError(
+                f"pi/dtheta = {nt:.6g} must be an integer >= 2: pick dtheta = pi/n, "
+                f"e.g. pi/{max(2, round(nt))}."
+            )
 
     @property
     def m(self) -> int:
@@ -75,8 +81,9 @@ class PolarGrid:
         r_lo = np.clip(rr - self.dr / 2, 0.0, self.L)
         r_hi = np.clip(rr + self.dr / 2, 0.0, self.L)
         corners = [(r_lo, t_lo), (r_hi, t_lo), (r_hi, t_hi), (r_lo, t_hi)]
-        q = np.stack([np.stack([(r * np.cos(t)).ravel(), (r * np.sin(t)).ravel()], -1)
-                      for r, t in corners], axis=1)
+        q = np.stack(
+            [np.stack([(r * np.cos(t)).ravel(), (r * np.sin(t)).ravel()], -1) for r, t in corners], axis=1
+        )
         return q
 
     def cell_areas(self) -> np.ndarray:
@@ -120,8 +127,8 @@ class PolarGrid:
     def centreline(self):
         """Node indices and x of the line y = 0 from x = -L to L: (idx, x)."""
         m, n = self.m, self.n
-        left = [(m - 1) * n + j for j in range(n - 1, 0, -1)]   # theta = pi, x < 0
-        right = [j for j in range(n)]                             # theta = 0, x >= 0
+        left = [(m - 1) * n + j for j in range(n - 1, 0, -1)]  # theta = pi, x < 0
+        right = [j for j in range(n)]  # theta = 0, x >= 0
         idx = np.array(left + right)
-        x = np.concatenate([-self.r[n - 1:0:-1], self.r])
+        x = np.concatenate([-self.r[n - 1 : 0 : -1], self.r])
         return idx, x

@@ -181,9 +181,7 @@ def _rung(k: int) -> dict:
 #: 1.45`` (about ``sqrt(2)``) in every mesh size, hence about 2.05 in element
 #: count.  Element counts of the half disk, ``L = 2``: coarse 1468, medium 2982,
 #: fine 6092, xfine 12660 (full disk: about twice); see ``meshes/README.md``.
-LADDER: dict[str, dict] = {
-    name: _rung(k) for k, name in enumerate(("coarse", "medium", "fine", "xfine"))
-}
+LADDER: dict[str, dict] = {name: _rung(k) for k, name in enumerate(("coarse", "medium", "fine", "xfine"))}
 
 _MESHES_DIR = pathlib.Path(__file__).resolve().parents[2] / "meshes"
 _USER_CACHE = pathlib.Path("~/.cache/femehl")
@@ -195,9 +193,7 @@ def _ladder_filename(name: str, half: bool) -> str:
 
 def _check_ladder_name(name) -> None:
     if not isinstance(name, str) or name not in LADDER:
-        raise MeshError(
-            f"unknown mesh ladder name {name!r}; use one of {', '.join(LADDER)}"
-        )
+        raise MeshError(f"unknown mesh ladder name {name!r}; use one of {', '.join(LADDER)}")
 
 
 def ladder_path(name: str, half: bool = True) -> pathlib.Path:
@@ -274,7 +270,6 @@ def _write_msh(dm: DiskMesh, path: pathlib.Path) -> None:
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
-
 
 
 # ---------------------------------------------------------------------------
@@ -429,8 +424,9 @@ def graded_disk(
     # sample finely where h dips (the edge annulus and its transitions), then refuse
     # sizes that would make gmsh run for hours or the operator overflow the memory
     w = _EDGE_TRANSITION
-    r = np.union1d(np.linspace(0.0, L, 4001),
-                   np.linspace(max(a - w, 0.0), max(min(b + w, L), max(a - w, 0.0)), 2001))
+    r = np.union1d(
+        np.linspace(0.0, L, 4001), np.linspace(max(a - w, 0.0), max(min(b + w, L), max(a - w, 0.0)), 2001)
+    )
     ne = _element_integral(r[r <= L], L, bool(half), h)
     if not ne <= MAX_GMSH_ELEMENTS:
         raise MeshError(
@@ -710,8 +706,10 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
     if not path.is_file():
         raise MeshError(f"mesh path '{path}' is not a regular file; pass a mesh file ({_READABLE})")
     if not os.access(path, os.R_OK):
-        raise MeshError(f"mesh file '{path}' is not readable (permission denied); fix its "
-                        "permissions or pass a copy you can read")
+        raise MeshError(
+            f"mesh file '{path}' is not readable (permission denied); fix its "
+            "permissions or pass a copy you can read"
+        )
     # meshio prints the errors of the formats it tries (.msh: ansys, then gmsh)
     # and calls sys.exit when none works: capture the output, catch the exit.
     chatter = io.StringIO()
@@ -740,9 +738,7 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
     if pts.ndim != 2 or pts.shape[1] < 2:
         raise MeshError(f"'{path}' has points of shape {pts.shape}; femehl needs x, y coordinates")
     if t.size and (t.min() < 0 or t.max() >= pts.shape[0]):
-        raise MeshError(
-            f"'{path}' has triangles with node indices out of range; re-export the mesh"
-        )
+        raise MeshError(f"'{path}' has triangles with node indices out of range; re-export the mesh")
     if pts.shape[1] > 2 and t.size:
         z = pts[np.unique(t), 2:]
         if np.all(np.isfinite(z)) and np.ptp(z, axis=0).max() > _RTOL_BOUNDARY * L:

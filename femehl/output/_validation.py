@@ -25,8 +25,9 @@ __all__ = [
 def check_count(name: str, value, minimum: int = 0, hint: str = "") -> int:
     """``value`` as an int >= ``minimum``; booleans, floats and strings are refused."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise SceneError(f"{name} must be an integer >= {minimum}, got {value!r} "
-                         f"({type(value).__name__}). {hint}".strip())
+        raise SceneError(
+            f"{name} must be an integer >= {minimum}, got {value!r} ({type(value).__name__}). {hint}".strip()
+        )
     if value < minimum:
         raise SceneError(f"{name} must be an integer >= {minimum}, got {value}. {hint}".strip())
     return int(value)
@@ -43,8 +44,10 @@ def check_resume_overwrite(resume, overwrite) -> tuple[bool, bool]:
     """Both flags as bools; asking for both at once is refused."""
     resume, overwrite = check_flag("resume", resume), check_flag("overwrite", overwrite)
     if resume and overwrite:
-        raise SceneError("resume and overwrite exclude each other: --resume continues the run in the "
-                         "folder, --overwrite replaces it; give one of them.")
+        raise SceneError(
+            "resume and overwrite exclude each other: --resume continues the run in the "
+            "folder, --overwrite replaces it; give one of them."
+        )
     return resume, overwrite
 
 
@@ -56,12 +59,17 @@ def check_run_options(t_end, dt, store_every, checkpoint_every):
     from ..stepping import check_run
 
     t_end, dt, nsteps = check_run(t_end, dt)
-    store_every = check_count("store_every", store_every, 0,
-                              "Give how many steps apart fields are written (0: only at the end).")
+    store_every = check_count(
+        "store_every", store_every, 0, "Give how many steps apart fields are written (0: only at the end)."
+    )
     if checkpoint_every is None:
         checkpoint_every = store_every
-    checkpoint_every = check_count("checkpoint_every", checkpoint_every, 0,
-                                   "Give how many steps apart the checkpoint is saved (0: only at the end).")
+    checkpoint_every = check_count(
+        "checkpoint_every",
+        checkpoint_every,
+        0,
+        "Give how many steps apart the checkpoint is saved (0: only at the end).",
+    )
     return t_end, dt, nsteps, store_every, checkpoint_every
 
 
@@ -106,8 +114,17 @@ def check_method_flags(method: str, given: dict) -> None:
             continue
         bad.append(flag)
     if bad:
-        users = sorted({m for key, value in given.items() if value is not None and key in METHOD_FLAGS
-                        for m in METHOD_FLAGS[key][1]} - {method})
+        users = sorted(
+            {
+                m
+                for key, value in given.items()
+                if value is not None and key in METHOD_FLAGS
+                for m in METHOD_FLAGS[key][1]
+            }
+            - {method}
+        )
         hint = METHOD_HINTS.get(method) or (f" or use --method {' / '.join(users)}" if users else "")
-        raise SceneError(f"{', '.join(bad)} do(es) not apply to --method {method}: drop "
-                         f"{'them' if len(bad) > 1 else 'it'}{hint}.")
+        raise SceneError(
+            f"{', '.join(bad)} do(es) not apply to --method {method}: drop "
+            f"{'them' if len(bad) > 1 else 'it'}{hint}."
+        )

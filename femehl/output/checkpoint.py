@@ -64,8 +64,10 @@ FORMAT = 1
 _ARRAYS = ("p", "w", "d")
 _SCALARS = ("step", "t", "hc", "V", "load", "film_center", "film_min", "p_max")
 _KEYS = _ARRAYS + _SCALARS + ("film_min_at", "p_max_at", "has_prev", "d_prev", "dt_prev")
-_FIX = ("restore an intact copy of it, or start the run again with overwrite=True (--overwrite) "
-        "or in another folder (--out)")
+_FIX = (
+    "restore an intact copy of it, or start the run again with overwrite=True (--overwrite) "
+    "or in another folder (--out)"
+)
 
 
 def _atomic_write(path: pathlib.Path, write):
@@ -85,8 +87,7 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["film_min_at"] = np.asarray(state.film_min_at, dtype=float)
     arrays["p_max_at"] = np.asarray(state.p_max_at, dtype=float)
     arrays["has_prev"] = np.asarray(state.d_prev is not None)
-    arrays["d_prev"] = (np.asarray(state.d_prev, dtype=float) if state.d_prev is not None
-                        else np.zeros(0))
+    arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
     arrays["format"] = np.asarray(FORMAT)
     path = folder / CHECKPOINT
@@ -114,8 +115,10 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
     """
     path = pathlib.Path(folder) / CHECKPOINT
     if not path.is_file():
-        raise CheckpointError(f"no checkpoint in {str(path.parent)!r} ({CHECKPOINT} is missing): "
-                              "run without resume first, or give the folder of the run to continue.")
+        raise CheckpointError(
+            f"no checkpoint in {str(path.parent)!r} ({CHECKPOINT} is missing): "
+            "run without resume first, or give the folder of the run to continue."
+        )
     try:
         with np.load(path, allow_pickle=False) as z:
             if not hasattr(z, "files"):
@@ -138,13 +141,24 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         raise _bad(path, f"an entry has the wrong type ({exc})") from None
     if step < 0 or not math.isfinite(floats["t"]) or floats["t"] < 0:
         raise _bad(path, f"its step {step} / time {floats['t']} is not a time a run reaches")
-    state = State(step=step, t=floats["t"], hc=floats["hc"], V=floats["V"],
-                  p=arrays["p"], w=arrays["w"], d=arrays["d"], load=floats["load"],
-                  film_center=floats["film_center"], film_min=floats["film_min"],
-                  film_min_at=tuple(arrays["film_min_at"].tolist()), p_max=floats["p_max"],
-                  p_max_at=tuple(arrays["p_max_at"].tolist()), info={"resumed": True},
-                  d_prev=arrays["d_prev"] if has_prev else None,
-                  dt_prev=None if math.isnan(dt_prev) else dt_prev)
+    state = State(
+        step=step,
+        t=floats["t"],
+        hc=floats["hc"],
+        V=floats["V"],
+        p=arrays["p"],
+        w=arrays["w"],
+        d=arrays["d"],
+        load=floats["load"],
+        film_center=floats["film_center"],
+        film_min=floats["film_min"],
+        film_min_at=tuple(arrays["film_min_at"].tolist()),
+        p_max=floats["p_max"],
+        p_max_at=tuple(arrays["p_max_at"].tolist()),
+        info={"resumed": True},
+        d_prev=arrays["d_prev"] if has_prev else None,
+        dt_prev=None if math.isnan(dt_prev) else dt_prev,
+    )
     if reference is not None:
         check_state(state, reference, path)
     return state
@@ -159,8 +173,11 @@ def check_state(state: State, reference: State, path="checkpoint") -> None:
         if not np.all(np.isfinite(getattr(state, k))):
             raise _bad(path, f"its array {k!r} has non-finite values")
     if state.d_prev is not None and np.shape(state.d_prev) != np.shape(reference.d):
-        raise _bad(path, f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
-                   f"the discretization needs {np.shape(reference.d)}")
+        raise _bad(
+            path,
+            f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
+            f"the discretization needs {np.shape(reference.d)}",
+        )
 
 
 # ---- run parameters ------------------------------------------------------------------------
@@ -179,14 +196,17 @@ def describe(obj, depth: int = 0):
         v = float(obj)
         return v if math.isfinite(v) else repr(v)
     if isinstance(obj, np.ndarray):
-        return {"array_sha1": hashlib.sha1(np.ascontiguousarray(obj).tobytes()).hexdigest(),
-                "shape": list(obj.shape)}
+        return {
+            "array_sha1": hashlib.sha1(np.ascontiguousarray(obj).tobytes()).hexdigest(),
+            "shape": list(obj.shape),
+        }
     if isinstance(obj, (list, tuple)):
         return [describe(v, depth + 1) for v in obj]
     if isinstance(obj, dict):
         return {str(k): describe(v, depth + 1) for k, v in obj.items()}
     if callable(obj):
-        return {"callable": f"{getattr(obj, '__module__', '?')}.{getattr(obj, '__qualname__', type(obj).__name__)}"}
+        name = getattr(obj, "__qualname__", type(obj).__name__)
+        return {"callable": f"{getattr(obj, '__module__', '?')}.{name}"}
     return repr(obj)
 
 
@@ -212,8 +232,13 @@ def _disc_signature(stepper) -> dict:
 
 def run_params(scene, stepper, dt: float) -> dict:
     """What must match for a resume: scene, method, discretization (dt is informative)."""
-    return {"format": FORMAT, "method": stepper.method, "scene": describe(scene),
-            "discretization": _disc_signature(stepper), "dt": float(dt)}
+    return {
+        "format": FORMAT,
+        "method": stepper.method,
+        "scene": describe(scene),
+        "discretization": _disc_signature(stepper),
+        "dt": float(dt),
+    }
 
 
 def write_params(folder, params: dict) -> pathlib.Path:
@@ -229,13 +254,17 @@ def read_params(folder) -> dict:
     try:
         params = json.loads(path.read_text())
     except FileNotFoundError:
-        raise CheckpointError(f"no {PARAMS} next to the checkpoint in {str(path.parent)!r}: cannot "
-                              f"check that the run to resume is the same; {_FIX}.") from None
+        raise CheckpointError(
+            f"no {PARAMS} next to the checkpoint in {str(path.parent)!r}: cannot "
+            f"check that the run to resume is the same; {_FIX}."
+        ) from None
     except (OSError, ValueError) as exc:
         raise CheckpointError(f"cannot read {str(path)!r} ({type(exc).__name__}: {exc}); {_FIX}.") from None
     if not isinstance(params, dict):
-        raise CheckpointError(f"{str(path)!r} holds a JSON {type(params).__name__}, not the object of "
-                              f"run parameters femehl writes; {_FIX}.")
+        raise CheckpointError(
+            f"{str(path)!r} holds a JSON {type(params).__name__}, not the object of "
+            f"run parameters femehl writes; {_FIX}."
+        )
     missing = [k for k in ("method", "scene", "discretization") if k not in params]
     if missing:
         raise CheckpointError(f"{str(path)!r} lacks the run parameters {missing}; {_FIX}.")
@@ -253,7 +282,7 @@ def _diff(a, b, where=""):
                 return d
         return None
     if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
-        for i, (x, y) in enumerate(zip(a, b)):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
             d = _diff(x, y, f"{where}[{i}]")
             if d:
                 return d
@@ -267,9 +296,11 @@ def check_params(saved: dict, current: dict) -> None:
         d = _diff(saved.get(key), current.get(key), key)
         if d:
             path, was, now = d
-            raise SceneError(f"cannot resume: {path} differs from the checkpointed run "
-                             f"(checkpoint: {was!r}, now: {now!r}). Resume with the same scene, "
-                             "method and mesh/grid, or start a new run in another folder.")
+            raise SceneError(
+                f"cannot resume: {path} differs from the checkpointed run "
+                f"(checkpoint: {was!r}, now: {now!r}). Resume with the same scene, "
+                "method and mesh/grid, or start a new run in another folder."
+            )
 
 
 # ---- reopening the outputs ------------------------------------------------------------------
@@ -306,8 +337,11 @@ def _continue_series(writer, t_ckpt: float) -> None:
     writer.next_index = max((n for n, _, _ in found), default=-1) + 1
     kept = [name for _, name, t in found if t is None or t > t_ckpt + tol]
     if kept:
-        logger.info("femehl: kept %d field file(s) out of the index (past the checkpoint or of unknown "
-                    "time): %s", len(kept), ", ".join(kept[:5]) + (", ..." if len(kept) > 5 else ""))
+        logger.info(
+            "femehl: kept %d field file(s) out of the index (past the checkpoint or of unknown time): %s",
+            len(kept),
+            ", ".join(kept[:5]) + (", ..." if len(kept) > 5 else ""),
+        )
     writer._write_index()
 
 

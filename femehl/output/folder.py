@@ -17,13 +17,23 @@ from ..errors import CheckpointError, OutputError
 __all__ = ["RUN_FILES", "check_folder", "clear_run_files", "prepare_folder", "run_files"]
 
 #: the files a femehl run writes into its folder (besides the field series fields_NNNNNN.vtu)
-RUN_FILES = ("summary.csv", "summary_si.csv", "fields.pvd", "checkpoint.npz", "checkpoint.json",
-             "centreline.png", "fields.png", "line.png")
+RUN_FILES = (
+    "summary.csv",
+    "summary_si.csv",
+    "fields.pvd",
+    "checkpoint.npz",
+    "checkpoint.json",
+    "centreline.png",
+    "fields.png",
+    "line.png",
+)
 _SERIES = re.compile(r"fields_\d+\.vtu$")
 _TEMPORARY = re.compile(r"(fields\.pvd|checkpoint\.npz|checkpoint\.json|fields_\d+\.vtu)\.tmp$")
 
-_FIX = ("give overwrite=True (--overwrite) to replace it, resume=True (--resume) to continue it, "
-        "or another folder (--out)")
+_FIX = (
+    "give overwrite=True (--overwrite) to replace it, resume=True (--resume) to continue it, "
+    "or another folder (--out)"
+)
 
 
 def _is_run_file(name: str) -> bool:
@@ -35,8 +45,9 @@ def run_files(folder, temporary: bool = False) -> list[pathlib.Path]:
     folder = pathlib.Path(folder)
     if not folder.is_dir():
         return []
-    return sorted(p for p in folder.iterdir()
-                  if _is_run_file(p.name) or (temporary and _TEMPORARY.match(p.name)))
+    return sorted(
+        p for p in folder.iterdir() if _is_run_file(p.name) or (temporary and _TEMPORARY.match(p.name))
+    )
 
 
 def _writable(path: pathlib.Path) -> bool:
@@ -50,18 +61,26 @@ def _check_path(folder: pathlib.Path) -> None:
             break
         if p.exists() or p.is_symlink():
             if p == folder:
-                raise OutputError(f"the output folder {str(folder)!r} is a file, not a folder: "
-                                  "give another folder (--out), or move the file away.")
-            raise OutputError(f"the output folder {str(folder)!r} cannot be made: {str(p)!r} is a "
-                              "file, not a folder; give another folder (--out).")
-    else:                                                  # pragma: no cover - "/" always exists
+                raise OutputError(
+                    f"the output folder {str(folder)!r} is a file, not a folder: "
+                    "give another folder (--out), or move the file away."
+                )
+            raise OutputError(
+                f"the output folder {str(folder)!r} cannot be made: {str(p)!r} is a "
+                "file, not a folder; give another folder (--out)."
+            )
+    else:  # pragma: no cover - "/" always exists
         p = folder
     if not _writable(p):
         if p == folder:
-            raise OutputError(f"the output folder {str(folder)!r} is not writable: give another "
-                              "folder (--out) or change its permissions.")
-        raise OutputError(f"the output folder {str(folder)!r} cannot be made: {str(p)!r} is not "
-                          "writable; give another folder (--out) or change its permissions.")
+            raise OutputError(
+                f"the output folder {str(folder)!r} is not writable: give another "
+                "folder (--out) or change its permissions."
+            )
+        raise OutputError(
+            f"the output folder {str(folder)!r} cannot be made: {str(p)!r} is not "
+            "writable; give another folder (--out) or change its permissions."
+        )
 
 
 def check_folder(folder, *, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
@@ -76,22 +95,28 @@ def check_folder(folder, *, resume: bool = False, overwrite: bool = False) -> pa
     _check_path(folder)
     if not folder.is_dir():
         if resume:
-            raise CheckpointError(f"cannot resume: the output folder {str(folder)!r} does not exist; "
-                                  "give the folder of the run to continue, or run without resume.")
+            raise CheckpointError(
+                f"cannot resume: the output folder {str(folder)!r} does not exist; "
+                "give the folder of the run to continue, or run without resume."
+            )
         return folder
     for name in RUN_FILES:
         p = folder / name
         if p.exists() and not p.is_file():
-            raise OutputError(f"{str(p)!r} is not a regular file (a directory?), but femehl writes its "
-                              f"{name} there: move it away or give another folder (--out).")
+            raise OutputError(
+                f"{str(p)!r} is not a regular file (a directory?), but femehl writes its "
+                f"{name} there: move it away or give another folder (--out)."
+            )
     present = run_files(folder)
     if present and not (resume or overwrite):
         names = ", ".join(p.name for p in present[:4]) + (", ..." if len(present) > 4 else "")
         raise OutputError(f"the output folder {str(folder)!r} already holds a run ({names}): {_FIX}.")
     if resume and not (folder / "checkpoint.npz").is_file():
-        raise CheckpointError(f"cannot resume: no checkpoint in {str(folder)!r} (checkpoint.npz is "
-                              "missing); give the folder of the run to continue, or start it again "
-                              "with overwrite=True (--overwrite).")
+        raise CheckpointError(
+            f"cannot resume: no checkpoint in {str(folder)!r} (checkpoint.npz is "
+            "missing); give the folder of the run to continue, or start it again "
+            "with overwrite=True (--overwrite)."
+        )
     return folder
 
 
@@ -115,5 +140,7 @@ def prepare_folder(folder, *, overwrite: bool = False) -> list[pathlib.Path]:
         folder.mkdir(parents=True, exist_ok=True)
         return clear_run_files(folder) if overwrite else []
     except OSError as exc:
-        raise OutputError(f"cannot prepare the output folder {str(folder)!r} ({exc.strerror or exc}): "
-                          "give another folder (--out) or fix its permissions.") from None
+        raise OutputError(
+            f"cannot prepare the output folder {str(folder)!r} ({exc.strerror or exc}): "
+            "give another folder (--out) or fix its permissions."
+        ) from None

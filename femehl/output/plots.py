@@ -11,8 +11,10 @@ __all__ = ["centreline_png", "profile_times", "quicklook_png"]
 
 def _plt():
     import matplotlib
+
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
+
     return plt
 
 
@@ -51,7 +53,7 @@ def centreline_png(results, path, times=None, labels=None, L=None):
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7.5, 7), sharex=True)
     styles = ["-", "--", ":", "-."]
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for k, (res, lab) in enumerate(zip(results, labels)):
+    for k, (res, lab) in enumerate(zip(results, labels, strict=True)):
         for i, t in enumerate(times):
             kw = {"color": colors[i % len(colors)], "ls": styles[k % len(styles)]}
             ax1.plot(x, res.pressure_at(pts, t), label=f"{lab} t={t:g}", **kw)
@@ -117,8 +119,10 @@ def line_png(result, path):
 
 
 #: the figures of a run folder, by the dimension of the discretization: (file name, drawer)
-FIGURES = {1: (("line.png", line_png),),
-           2: (("centreline.png", centreline_png), ("fields.png", quicklook_png))}
+FIGURES = {
+    1: (("line.png", line_png),),
+    2: (("centreline.png", centreline_png), ("fields.png", quicklook_png)),
+}
 
 
 def draw_figures(result, folder):

@@ -55,7 +55,7 @@ class SeriesWriter:
         self.stem = stem
         self.points, self.cells, self.on_nodes = grid_cells(disc)
         self.entries: list[tuple[float, str]] = []
-        self.next_index = 0                 # number of the next file (never one present)
+        self.next_index = 0  # number of the next file (never one present)
 
     @property
     def pvd_path(self) -> pathlib.Path:
@@ -70,8 +70,13 @@ class SeriesWriter:
         else:
             point_data = {"pressure": state.p}
             cell_data = {"film": [state.d], "deflection": [state.w], "gap": [h]}
-        mesh = meshio.Mesh(self.points, self.cells, point_data=point_data, cell_data=cell_data,
-                           field_data={"TimeValue": np.array([state.t])})
+        mesh = meshio.Mesh(
+            self.points,
+            self.cells,
+            point_data=point_data,
+            cell_data=cell_data,
+            field_data={"TimeValue": np.array([state.t])},
+        )
         path = self.folder / name
         tmp = path.with_name(path.name + ".tmp")
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
@@ -83,9 +88,11 @@ class SeriesWriter:
         return path
 
     def _write_index(self):
-        lines = ['<?xml version="1.0"?>',
-                 '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
-                 "  <Collection>"]
+        lines = [
+            '<?xml version="1.0"?>',
+            '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+            "  <Collection>",
+        ]
         for t, name in self.entries:
             lines.append(f'    <DataSet timestep="{t:.12g}" group="" part="0" file={quoteattr(name)}/>')
         lines += ["  </Collection>", "</VTKFile>", ""]
@@ -101,8 +108,10 @@ _TIME_RE = re.compile(rb'Name="TimeValue"[^>]*>\s*([^<\s]+)\s*<')
 def _add_time_value(path: pathlib.Path, t: float) -> None:
     """Put ``TimeValue`` field data in a .vtu (meshio's writer leaves field data out)."""
     data = path.read_bytes()
-    block = (b'\n<FieldData>\n<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
-             b'format="ascii">' + repr(float(t)).encode() + b"</DataArray>\n</FieldData>")
+    block = (
+        b'\n<FieldData>\n<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
+        b'format="ascii">' + repr(float(t)).encode() + b"</DataArray>\n</FieldData>"
+    )
     i = data.find(_GRID_TAG)
     if i >= 0:
         i += len(_GRID_TAG)
@@ -169,7 +178,7 @@ def scan_series(folder, stem: str = "fields") -> list[tuple[int, str, float | No
         if m is None or not path.is_file():
             continue
         t = vtu_time(path)
-        if t is None and _complete(path):             # written before files carried their time
+        if t is None and _complete(path):  # written before files carried their time
             t = index.get(path.name)
         out.append((int(m.group(1)), path.name, t))
     return sorted(out)

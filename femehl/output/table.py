@@ -7,14 +7,35 @@ import pathlib
 
 __all__ = ["COLUMNS", "SummaryWriter"]
 
-COLUMNS = ("t", "hc", "V", "load", "film_center", "film_min", "film_min_x", "film_min_y",
-           "p_max", "p_max_x", "p_max_y")
+COLUMNS = (
+    "t",
+    "hc",
+    "V",
+    "load",
+    "film_center",
+    "film_min",
+    "film_min_x",
+    "film_min_y",
+    "p_max",
+    "p_max_x",
+    "p_max_y",
+)
 
 
 def _row(state):
-    return (state.t, state.hc, state.V, state.load, state.film_center, state.film_min,
-            state.film_min_at[0], state.film_min_at[1], state.p_max, state.p_max_at[0],
-            state.p_max_at[1])
+    return (
+        state.t,
+        state.hc,
+        state.V,
+        state.load,
+        state.film_center,
+        state.film_min,
+        state.film_min_at[0],
+        state.film_min_at[1],
+        state.p_max,
+        state.p_max_at[0],
+        state.p_max_at[1],
+    )
 
 
 class SummaryWriter:

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..validation import check_finite
 from ..errors import SceneError
+from ..validation import check_finite
 
 __all__ = ["HalfSpace"]
 

@@ -147,6 +147,9 @@ class LineScene(SceneEffects):
             object.__setattr__(
                 self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity, load=self.load)
             )
+            times = np.union1d(np.linspace(0.0, 10.0, 201), getattr(self.load, "times", ()))
+            for t in times[times >= 0.0]:
+                self.motion.F(t)  # refuses a negative (pulling) load up front, naming the time
         hc0 = self.motion.hc(0.0)
         if hc0 <= 0.0:
             raise SceneError(

@@ -31,7 +31,7 @@ from femehl.errors import SceneError
 from femehl.line import LineScene, line_nodes
 from femehl.line_steady import steady_line, steady_line_load
 from femehl.result import Result
-from femehl.scene import Constant, Motion, RampHold, TanhStart
+from femehl.scene import Constant, Motion, RampHold, Table, TanhStart
 from femehl.stepping import State
 
 K, BETA, HC, L = 1.0, 10.0, -0.5, 2.0
@@ -357,3 +357,11 @@ def test_example_runs(tmp_path):
     out = mod.main(t_end=15.0, dt=0.2, n_elements=200, outdir=tmp_path, verbose=False)
     assert out["film_error"] < 1e-2 and out["load_error"] < 1e-4
     assert Path(out["png"]).is_file()
+
+
+def test_negative_line_load_is_refused_up_front():
+    """The film cannot pull: a load history going negative is refused when the scene is built."""
+    with pytest.raises(SceneError, match=r"F\(t=1\.7\) = -0\.01 is negative"):
+        LineScene(load=Table([0.0, 1.0, 2.0], [0.5, 0.2, -0.1]))
+    with pytest.raises(SceneError, match="negative"):
+        LineScene(load=-1.0)

@@ -20,13 +20,13 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementTriP0, ElementTriP1, asm
+from skfem import Basis, ElementTriP0, ElementTriP1
 
 from ..errors import SceneError
-from ..fe.forms import couette, film_diffusion, squeeze
 from ..fe.mesh import areas, centroids, load_mesh
 from ..kernels import edge_terms, mesh_edges, triangle_influence
 from . import register_method
+from ._p1p0 import P1P0
 
 __all__ = ["FEDisc"]
 
@@ -36,7 +36,7 @@ def _looks_like_path(s: str) -> bool:
 
 
 @register_method("fe")
-class FEDisc:
+class FEDisc(P1P0):
     """A disk mesh with P1 pressure and element-constant film.
 
     Parameters
@@ -82,27 +82,11 @@ class FEDisc:
         self.film_points = self.centroids
         self.areas = areas(dm)
         ne, nn = t.shape[1], p.shape[1]
-        # element average of a P1 field: (P p)_e = mean of its 3 nodal values
-        self.P = sp.csr_matrix(
-            (np.full(3 * ne, 1.0 / 3.0), (np.repeat(np.arange(ne), 3), t.T.ravel())), shape=(ne, nn)
-        )
         r = np.hypot(p[0], p[1])
-        self.free = np.flatnonzero(r < self.L * (1.0 - 1e-9))
-        self.free_index = self.free
-        self.n = int(self.free.size)
+        self._build_forms(b1, b0, np.flatnonzero(r < self.L * (1.0 - 1e-9)))
         self.shape = self.gap(self.centroids)
         self.node_shape = self.gap(self.nodes)
-        # nodal estimate of a film-point field: mean over the elements around each node
-        inc = sp.csr_matrix((np.ones(3 * ne), (t.T.ravel(), np.repeat(np.arange(ne), 3))), shape=(nn, ne))
-        self.node_average = sp.diags(1.0 / np.asarray(inc.sum(axis=1)).ravel()) @ inc
-        # element stiffness with unit coefficient; K(m) scales each element by m
-        kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(ne)))
-        self._k_rows, self._k_cols = kcoo.indices
-        self._k_data = kcoo.data.reshape(-1, ne)  # (9, ne), element last
-        Mfull = asm(squeeze, b0, b1).tocsr()
-        self._M = Mfull[self.free]
         mult = 2.0 if self.half else 1.0
-        self.node_weight = np.asarray(Mfull.sum(axis=1)).ravel()  # int phi_q dA
         self.load_weights = mult * self.node_weight[self.free]
         self._finder_ = None
         self.info = {
@@ -133,31 +117,7 @@ class FEDisc:
             )
         return s
 
-    def expand(self, p_free):
-        p = np.zeros(self.nnodes)
-        p[self.free] = p_free
-        return p
-
-    # ---- Reynolds operators ------------------------------------------------------------
-    def poiseuille(self, d, m, dm_dd=None):
-        """``K(m)[q, p] = int m grad p . grad q`` on the free nodes, m on elements."""
-        data = (self._k_data * m[None, :]).ravel()
-        n = self.nnodes
-        K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(n, n))
-        return K[self.free][:, self.free]
-
-    def couette(self):
-        """``Bx[q, e] = int_e dq/dx`` (free nodes x elements)."""
-        return asm(couette, self.basis0, self.basis).tocsr()[self.free]
-
-    def squeeze(self):
-        """``M[q, e] = int_e q`` (free nodes x elements)."""
-        return self._M
-
-    # ---- substrate primitives ------------------------------------------------------------
-    def average(self):
-        return self.P[:, self.free]
-
+    # ---- substrate primitives (the Reynolds operators come from P1P0) ----------------
     def _locate(self, points):
         if self._finder_ is None:
             import matplotlib.tri as mtri

@@ -18,17 +18,17 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementLineP0, ElementLineP1, MeshLine, asm
+from skfem import Basis, ElementLineP0, ElementLineP1, MeshLine
 
 from ..errors import SceneError
-from ..fe.forms import couette, film_diffusion, squeeze
 from . import register_method
+from ._p1p0 import P1P0
 
 __all__ = ["LineDisc"]
 
 
 @register_method("line")
-class LineDisc:
+class LineDisc(P1P0):
     """A 1-D mesh of ``[-L, L]`` for a :class:`femehl.line.LineScene`.
 
     Parameters
@@ -72,22 +72,9 @@ class LineDisc:
         self.L = scene.L
         self.nodes = np.column_stack([self.x, np.zeros(nn)])
         self.film_points = np.column_stack([self.xc, np.zeros(ne)])
-        self.P = sp.csr_matrix(
-            (np.full(2 * ne, 0.5), (np.repeat(np.arange(ne), 2), t.T.ravel())), shape=(ne, nn)
-        )
-        self.free = np.setdiff1d(np.arange(nn), self.mesh.boundary_nodes())
-        self.free_index = self.free
-        self.n = int(self.free.size)
+        self._build_forms(b1, b0, np.setdiff1d(np.arange(nn), self.mesh.boundary_nodes()))
         self.shape = self.gap(self.film_points)
         self.node_shape = self.gap(self.nodes)
-        inc = sp.csr_matrix((np.ones(2 * ne), (t.T.ravel(), np.repeat(np.arange(ne), 2))), shape=(nn, ne))
-        self.node_average = sp.diags(1.0 / np.asarray(inc.sum(axis=1)).ravel()) @ inc
-        kcoo = film_diffusion.coo_data(b1, d3=b0.interpolate(np.ones(ne)))
-        self._k_rows, self._k_cols = kcoo.indices
-        self._k_data = kcoo.data.reshape(-1, ne)
-        Mall = asm(squeeze, b0, b1).tocsr()
-        self._M = Mall[self.free]
-        self.node_weight = np.asarray(Mall.sum(axis=1)).ravel()  # int phi_q dx
         self.load_weights = self.node_weight[self.free]
         self.info = {
             "elements": ne,
@@ -103,28 +90,7 @@ class LineDisc:
     def gap(self, points):
         return self.scene.shape(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0])
 
-    def expand(self, p_free):
-        p = np.zeros(self.nnodes)
-        p[self.free] = p_free
-        return p
-
-    # ---- Reynolds operators ------------------------------------------------------------
-    def poiseuille(self, d, m, dm_dd=None):
-        """``K(m)[q, p] = int m p' q'`` on the free nodes (m element-constant)."""
-        data = (self._k_data * m[None, :]).ravel()
-        K = sp.csr_matrix((data, (self._k_rows, self._k_cols)), shape=(self.nnodes, self.nnodes))
-        return K[self.free][:, self.free]
-
-    def couette(self):
-        return asm(couette, self.basis0, self.basis).tocsr()[self.free]
-
-    def squeeze(self):
-        return self._M
-
-    # ---- substrate primitives ------------------------------------------------------------
-    def average(self):
-        return self.P[:, self.free]
-
+    # ---- substrate primitives (the Reynolds operators come from P1P0) ----------------
     def pressure_rows(self, points):
         """Sparse rows of the P1 interpolation in x at ``points`` (0 outside [-L, L])."""
         xq = np.asarray(points, dtype=float).reshape(-1, 2)[:, 0]

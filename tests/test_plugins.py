@@ -208,3 +208,15 @@ def test_every_linear_solver_solves_the_paper_step(name):
 def test_terms_must_have_distinct_names():
     with pytest.raises(femehl.SceneError, match="distinct"):
         femehl.make_stepper(femehl.presets.paper_sphere(), mesh="coarse", terms=[Poiseuille(), Poiseuille()])
+
+
+def test_registered_substrate_is_a_scene_file_kind(tmp_path, monkeypatch):
+    """A substrate registered from outside femehl is a ``[substrate] kind`` of TOML files."""
+    from femehl.scenefile import load_scene_file
+    from femehl.substrates import SUBSTRATES
+
+    monkeypatch.setitem(SUBSTRATES, SeriesSprings.kind, SeriesSprings)
+    path = tmp_path / "springs.toml"
+    path.write_text('[substrate]\nkind = "series_springs"\nk1 = 8.0\nk2 = 4.0\n[fluid]\nbeta = 200.0\n')
+    scene, _ = load_scene_file(path)
+    assert scene.substrate == SeriesSprings(8.0, 4.0)

@@ -16,12 +16,13 @@ The primitives are ``disc.boussinesq()`` / ``disc.boussinesq_rows(points)`` (exa
 integral of ``1/|x - x'|`` of the discretized unit pressure, mirror image included for a
 half domain), ``disc.average()`` (the pressure's value on the film points) and
 ``disc.pressure_rows(points)``.  A new substrate is one module defining such a class; no
-solver file changes.
+solver file changes; decorated with :func:`register_substrate` its ``kind`` also names
+it in TOML scene files (``[substrate] kind = "..."``).
 """
 
-from .base import Substrate
+from .base import SUBSTRATES, Substrate, register_substrate
 from .halfspace import HalfSpace
 from .rigid import Rigid
 from .winkler import Winkler
 
-__all__ = ["Substrate", "HalfSpace", "Winkler", "Rigid"]
+__all__ = ["Substrate", "SUBSTRATES", "register_substrate", "HalfSpace", "Winkler", "Rigid"]

@@ -4,7 +4,16 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
-__all__ = ["Substrate"]
+__all__ = ["Substrate", "SUBSTRATES", "register_substrate"]
+
+#: kind -> substrate class (the names of ``[substrate] kind`` in scene files)
+SUBSTRATES: dict[str, type] = {}
+
+
+def register_substrate(cls):
+    """Class decorator adding a substrate class to :data:`SUBSTRATES` under ``cls.kind``."""
+    SUBSTRATES[cls.kind] = cls
+    return cls
 
 
 @runtime_checkable

@@ -11,10 +11,12 @@ from dataclasses import dataclass
 
 from ..errors import SceneError
 from ..validation import check_finite
+from .base import register_substrate
 
 __all__ = ["HalfSpace"]
 
 
+@register_substrate
 @dataclass(frozen=True)
 class HalfSpace:
     """Elastic half space (Boussinesq, Eq. 3 / 10b).  ``compliance = 2 (1 - nu)``."""

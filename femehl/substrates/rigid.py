@@ -7,9 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .base import register_substrate
+
 __all__ = ["Rigid"]
 
 
+@register_substrate
 @dataclass(frozen=True)
 class Rigid:
     """Rigid substrate: w = 0, no elastic operator at all."""

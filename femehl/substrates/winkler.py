@@ -5,10 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..validation import check_positive
+from .base import register_substrate
 
 __all__ = ["Winkler"]
 
 
+@register_substrate
 @dataclass(frozen=True)
 class Winkler:
     """Winkler foundation: ``w = -p / k`` (local, diagonal)."""

@@ -82,8 +82,8 @@ import dataclasses
 import logging
 import math
 from collections import deque
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Callable, Iterator
 
 import numpy as np
 
@@ -99,6 +99,8 @@ logger = logging.getLogger("femehl")
 RETRY_FACTOR = 0.25
 #: "a few steps": a film closes when its last decrease extrapolates to zero within this many steps
 CLOSE_STEPS = 3.0
+#: ... or when, decreasing steadily, it is thinner than THIN_FILM times the initial thinnest film
+THIN_FILM = 1e-4
 #: the load component is relative to max(largest |load| so far, LOAD_FLOOR): loads are O(0.1 .. 1)
 #: in the paper's normalization, and a load growing from 0 has no relative error at t = 0
 LOAD_FLOOR = 0.1
@@ -137,15 +139,16 @@ class StepController:
 class _Run:
     """The explicit state of an adaptive run between trial steps."""
 
-    dt: float                                   # the next trial step
-    levels: list                                # accepted states since the last (re)start, <= 3
-    pending: State | None = None                # the Euler start step, yielded once its pair passes
+    dt: float  # the next trial step
+    levels: list  # accepted states since the last (re)start, <= 3
+    pending: State | None = None  # the Euler start step, yielded once its pair passes
     pending_rejected: int = 0
-    rejected: int = 0                           # trials discarded since the last yielded state
-    grow: bool = True                           # False right after a rejection
-    streak: int = 0                             # consecutive error rejections of this step
-    load_scale: float = 0.0                     # largest |load| so far
-    recent: deque = field(default_factory=lambda: deque(maxlen=4))   # last yielded states
+    rejected: int = 0  # trials discarded since the last yielded state
+    grow: bool = True  # False right after a rejection
+    streak: int = 0  # consecutive error rejections of this step
+    load_scale: float = 0.0  # largest |load| so far
+    recent: deque = field(default_factory=lambda: deque(maxlen=6))  # last yielded states
+    film0: float = math.nan  # the initial thinnest film
     accepted_total: int = 0
     rejected_total: int = 0
     dt_low: float = math.inf
@@ -204,14 +207,14 @@ def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float) -> floa
 
 def _predict(levels, t):
     w = _lagrange([s.t for s in levels], t)
-    d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels))
-    load_pred = float(sum(wi * s.load for wi, s in zip(w, levels)))
+    d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels, strict=True))
+    load_pred = float(sum(wi * s.load for wi, s in zip(w, levels, strict=True)))
     return d_pred, load_pred
 
 
 def _milne(run: _Run, trial: State, order: int) -> float:
     """The local error of a step of a method of ``order`` from its last ``order + 1`` levels."""
-    levels = run.levels[-(order + 1):]
+    levels = run.levels[-(order + 1) :]
     h = trial.t - levels[-1].t
     h1 = levels[-1].t - levels[-2].t
     if order == 1:
@@ -264,19 +267,28 @@ def _film_track(stepper, states, where):
     return ts, [film_floor(s)[0] for s in states]
 
 
-def _closing(ts, ds) -> float | None:
-    """The time the film reaches 0 if it closes steadily (see CLOSE_STEPS), else None."""
-    if len(ds) < 3 or not all(b < a for a, b in zip(ds, ds[1:])):
+def _closing(ts, ds, film0: float) -> float | None:
+    """The time the film reaches 0 if it closes steadily, else None.
+
+    Steadily: it decreased over each of the last (at least 3) accepted levels, and its last
+    rate of decrease reaches zero within CLOSE_STEPS steps, or it is already thinner than
+    THIN_FILM times the initial thinnest film ``film0``.
+    """
+    ts, ds = ts[-4:], ds[-4:]
+    if len(ds) < 3 or not all(b < a for a, b in zip(ds, ds[1:], strict=False)):
         return None
     h = ts[-1] - ts[-2]
     rate = (ds[-2] - ds[-1]) / h
-    if rate <= 0.0 or ds[-1] / rate > CLOSE_STEPS * h:
+    if rate <= 0.0:
+        return None
+    if ds[-1] / rate > CLOSE_STEPS * h and not ds[-1] < THIN_FILM * film0:
         return None
     return ts[-1] + ds[-1] / rate
 
 
-def _floor_error(stepper, run: _Run, t_new: float, h: float, dt_min: float, fail: _Failure | None,
-                 err: float | None = None):
+def _floor_error(
+    stepper, run: _Run, t_new: float, h: float, dt_min: float, fail: _Failure | None, err: float | None = None
+):
     """The error to raise when a retry would go below ``dt_min``."""
     last = run.levels[-1]
     if fail is not None and fail.where is not None:
@@ -286,24 +298,31 @@ def _floor_error(stepper, run: _Run, t_new: float, h: float, dt_min: float, fail
     x, y = (tuple(where) + (0.0, 0.0))[:2]
     states = list(run.recent)
     ts, ds = _film_track(stepper, states, where)
-    t_zero = _closing(ts, ds)
-    what = (f"a trial step of dt = {h:.3g} to t = {t_new:.6g} "
-            + (f"failed ({fail.reason})" if fail is not None else
-               f"has an error estimate {err:.3g} > tol"))
+    t_zero = _closing(ts, ds, run.film0)
+    what = f"a trial step of dt = {h:.3g} to t = {t_new:.6g} " + (
+        f"failed ({fail.reason})" if fail is not None else f"has an error estimate {err:.3g} > tol"
+    )
     history = ", ".join(f"{v:.3g}" for v in ds[-4:])
+    ts = ts[-4:]
     if t_zero is not None:
         exc = FilmRuptureError(
             f"the film closes (solid contact) near t = {t_new:.6g}, at {label} (x, y) = ({x:.3g}, "
             f"{y:.3g}): over the last accepted steps (t = {ts[0]:.6g} .. {ts[-1]:.6g}) it fell "
             f"steadily ({history}), which extrapolates to zero by t = {t_zero:.6g}, and {what} "
             f"at the step floor dt_min = {dt_min:.3g}. The load squeezes the film out: the "
-            "lubricated model no longer applies.", t=t_new, where=(x, y), d_min=float(d))
+            "lubricated model no longer applies.",
+            t=t_new,
+            where=(x, y),
+            d_min=float(d),
+        )
         exc.reason = "closes"
         return exc
-    msg = (f"adaptive step floor reached at t = {last.t:.6g}: {what}, and the next retry would "
-           f"be below dt_min = {dt_min:.3g}; the film at {label} (x, y) = ({x:.3g}, {y:.3g}) is "
-           f"{float(d):.3g} and was not closing steadily over the last accepted steps "
-           f"({history}). Try a finer discretization or a smaller dt_min.")
+    msg = (
+        f"adaptive step floor reached at t = {last.t:.6g}: {what}, and the next retry would "
+        f"be below dt_min = {dt_min:.3g}; the film at {label} (x, y) = ({x:.3g}, {y:.3g}) is "
+        f"{float(d):.3g} and was not closing steadily over the last accepted steps "
+        f"({history}). Try a finer discretization or a smaller dt_min."
+    )
     if fail is None:
         exc = SolverError(msg, t=last.t)
     else:
@@ -324,9 +343,17 @@ def _limits(t_span, tol, dt0, dt_min, dt_max):
 
 
 # ---- the time loop ------------------------------------------------------------------------
-def march_adaptive(stepper, t_end: float, *, tol: float, dt0: float | None = None,
-                   dt_min: float | None = None, dt_max: float | None = None,
-                   start: State | None = None, safety: float = 0.9) -> Iterator[State]:
+def march_adaptive(
+    stepper,
+    t_end: float,
+    *,
+    tol: float,
+    dt0: float | None = None,
+    dt_min: float | None = None,
+    dt_max: float | None = None,
+    start: State | None = None,
+    safety: float = 0.9,
+) -> Iterator[State]:
     """Yield the initial state, then every accepted state up to ``t_end`` (adaptive steps).
 
     Parameters
@@ -358,26 +385,34 @@ def march_adaptive(stepper, t_end: float, *, tol: float, dt0: float | None = Non
         raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
     dt0, dt_min, dt_max = _limits(t_end - state.t, tol, dt0, dt_min, dt_max)
     eps = 1e-12 * max(1.0, abs(t_end))
-    stops = sorted({b for b in breakpoints_of(getattr(stepper, "scene", None))
-                    if state.t + eps < b < t_end - eps} | {t_end})
+    stops = sorted(
+        {b for b in breakpoints_of(getattr(stepper, "scene", None)) if state.t + eps < b < t_end - eps}
+        | {t_end}
+    )
     ctl = StepController(tol, safety)
     order = _order(stepper)
 
     state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
-    run = _Run(dt=dt0, levels=[_restart(state)], load_scale=abs(state.load))
+    run = _Run(dt=dt0, levels=[_restart(state)], load_scale=abs(state.load), film0=film_floor(state)[0])
     run.recent.append(state)
     yield state
     for stop in stops:
         while stop - run.levels[-1].t > eps:
             yield from _advance(stepper, run, ctl, order, stop, dt_min, dt_max)
-        if run.pending is not None:          # an Euler start step that reached the stop alone
+        if run.pending is not None:  # an Euler start step that reached the stop alone
             yield from _emit(run, run.pending, run.pending_rejected, math.nan)
-        if stop < t_end:                     # a breakpoint: the derivatives jump, restart
+        if stop < t_end:  # a breakpoint: the derivatives jump, restart
             run.levels = [_restart(run.levels[-1])]
             run.dt = min(run.dt, dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
-    logger.info("adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
-                t_end, run.accepted_total, run.rejected_total, run.dt_low, run.dt_high)
+    logger.info(
+        "adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
+        t_end,
+        run.accepted_total,
+        run.rejected_total,
+        run.dt_low,
+        run.dt_high,
+    )
 
 
 def _emit(run: _Run, state: State, rejected: int, err: float):
@@ -398,13 +433,12 @@ def _reject(run: _Run, n: int, new_dt: float, what: str, t: float, h: float):
     run.dt = new_dt
 
 
-def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, dt_min: float,
-             dt_max: float):
+def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, dt_min: float, dt_max: float):
     """One trial step toward ``stop``; yields the states it accepts (none, one or two)."""
     base = run.levels[-1]
     remaining = stop - base.t
     start_step = len(run.levels) == 1
-    if start_step:        # the Euler start step leaves room for the second step of its pair
+    if start_step:  # the Euler start step leaves room for the second step of its pair
         h = remaining if remaining <= 2.0 * dt_min else min(run.dt, dt_max, 0.5 * remaining)
     else:
         h = _next_h(min(run.dt, dt_max), remaining)
@@ -421,27 +455,33 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
         run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0
         run.dt = h
         return
-    if run.pending is not None:               # the second step judges the Euler start step
+    if run.pending is not None:  # the second step judges the Euler start step
         err, p = _start_error(run, trial), 1
     else:
         err, p = _milne(run, trial, order), order
     if not ctl.accepts(err):
         if h <= dt_min * (1.0 + 1e-9):
             raise _floor_error(stepper, run, t_new, h, dt_min, None, err)
-        if run.pending is not None:           # reject the pair: back to the level before it
+        if run.pending is not None:  # reject the pair: back to the level before it
             h1 = run.pending.t - run.levels[0].t
             if h1 <= dt_min * (1.0 + 1e-9):
                 raise _floor_error(stepper, run, t_new, h1, dt_min, None, err)
             run.levels = run.levels[:1]
             run.rejected += run.pending_rejected + 1
             run.pending = None
-            _reject(run, 1, max(h1 * ctl.factor(err, 1, grow=False, dt=h1), dt_min), f"start pair error "
-                    f"{err:.3g} > tol", t_new, h1)
+            _reject(
+                run,
+                1,
+                max(h1 * ctl.factor(err, 1, grow=False, dt=h1), dt_min),
+                f"start pair error {err:.3g} > tol",
+                t_new,
+                h1,
+            )
             run.rejected_total += 1
         else:
             run.streak += 1
             f = ctl.factor(err, p, grow=False, dt=h)
-            if run.streak > 1:               # the estimate is not asymptotic here: cut hard
+            if run.streak > 1:  # the estimate is not asymptotic here: cut hard
                 f = min(f, ctl.fac_min)
             _reject(run, 1, max(h * f, dt_min), f"error {err:.3g} > tol", t_new, h)
         return
@@ -451,7 +491,7 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
     run.rejected = 0
     run.levels = (run.levels + [trial])[-3:]
     f = ctl.factor(err, p, grow=run.grow, dt=h)
-    if 1.0 <= f < ctl.hold:                  # small growth is not worth a new operator
+    if 1.0 <= f < ctl.hold:  # small growth is not worth a new operator
         f = 1.0
     run.dt = min(dt_max, max(dt_min, h * f))
     run.grow = True
@@ -459,8 +499,16 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
 
 
 # ---- drivers ------------------------------------------------------------------------------
-def run_adaptive(stepper, t_end: float, *, tol: float, start: State | None = None, store_every: int = 1,
-                 on_state: Callable[[State], None] | None = None, **controls):
+def run_adaptive(
+    stepper,
+    t_end: float,
+    *,
+    tol: float,
+    start: State | None = None,
+    store_every: int = 1,
+    on_state: Callable[[State], None] | None = None,
+    **controls,
+):
     """:func:`femehl.api.run_loop` with adaptive steps: march and record into a Result.
 
     ``controls`` are ``dt0``, ``dt_min``, ``dt_max``, ``safety`` of :func:`march_adaptive`.
@@ -494,13 +542,25 @@ def run_adaptive(stepper, t_end: float, *, tol: float, start: State | None = Non
         if last is not None and store_every > 0 and not last[1]:
             result._stored.append(last[0])
         result.info.update(getattr(stepper, "info", {}))
-        result.info.update(steps=result.nsteps, tol=tol, rejected_steps=rejected,
-                           dt_smallest=min(dts, default=math.nan), dt_largest=max(dts, default=math.nan))
+        result.info.update(
+            steps=result.nsteps,
+            tol=tol,
+            rejected_steps=rejected,
+            dt_smallest=min(dts, default=math.nan),
+            dt_largest=max(dts, default=math.nan),
+        )
     return result
 
 
-def solve_adaptive(scene, t_end: float, tol: float, method: str | None = None, store_every: int = 1,
-                   callback: Callable[[State], None] | None = None, **options):
+def solve_adaptive(
+    scene,
+    t_end: float,
+    tol: float,
+    method: str | None = None,
+    store_every: int = 1,
+    callback: Callable[[State], None] | None = None,
+    **options,
+):
     """Run ``scene`` from t = 0 to ``t_end`` with adaptive steps; return a Result.
 
     Like :func:`femehl.api.solve` with ``tol`` instead of ``dt``: the stepper is built by

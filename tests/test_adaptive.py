@@ -221,6 +221,16 @@ def test_step_floor_is_named():
     assert info.value.where == (0.0, 0.0) and info.value.d_min > 0
 
 
+def test_resume_from_a_state():
+    """``start``: the run restarts there (Euler start pair) and continues to t_end."""
+    ode = ScalarODE()
+    first = _run(ode, 2.0, tol=1e-3)
+    rest = _run(ode, 6.0, tol=1e-3, start=first[-1])
+    assert rest[0] is not first[-1] and rest[0].t == 2.0 and rest[-1].t == 6.0
+    assert any(s.t == 3.0 for s in rest)
+    assert _global_error(ode, first + rest[1:]) < 1.5e-3
+
+
 def test_bad_arguments():
     for kw in (
         dict(tol=0.0),

@@ -27,29 +27,41 @@ run (see ``tests/test_adaptive.py``).
 
 Norm
 ----
-Relative, in the max norm over the film points, with the load as one more component::
+Relative, in the max norm over the film points, with the load as one more component,
+and per unit time::
 
-    err = c * max( max_i |d_i - d_pred_i| / d_i ,  |F - F_pred| / max|F| )
+    err = c * max( max_i |d_i - d_pred_i| / d_i ,  |F - F_pred| / max(max|F|, 0.1) ) / max(h, 0.01)
 
 ``d_i > 0`` is the trial film at film point i (a trial with a film <= 0 is rejected
-before), ``F`` the load and ``max|F|`` the largest load of the run so far (the load
-component is left out while it is 0).  ``tol`` is thus a relative error per step.
+before), ``F`` the load and ``max|F|`` the largest load of the run so far; the floor
+``LOAD_FLOOR = 0.1`` (loads are O(0.1 .. 1) in the paper's normalization) keeps a load
+growing from 0 from having an infinite relative error at t = 0.  Dividing by ``h`` makes
+``tol`` a relative error per unit (normalized) time, so the global error follows ``tol``
+(measured: about 0.3 to 1 times tol, tests/test_adaptive.py) instead of growing with the
+number of steps.  Below ``UNIT_STEP = 0.01`` the division is by 0.01 (error per step of
+that length): an error per unit time cannot be met in the stiff initial layer of the
+film (time scale ~ 1e-6, amplitude ~ 1e-6), whose whole error is that small.
 
 Controller
 ----------
 A trial is accepted when ``err <= tol``.  Either way the next step is
-``dt_new = dt * min(fac_max, max(fac_min, safety * (tol/err)^(1/(p+1))))`` with
-``fac_min = 0.2``, ``fac_max = 2`` (variable-step BDF2 is zero-stable for step ratios
-below 1 + sqrt 2) and no growth on the step right after a rejection; ``dt`` stays in
-``[dt_min, dt_max]``.  When steady (``err -> 0``) steps grow by ``fac_max`` up to
-``dt_max``.
+``dt_new = dt * min(fac_max, max(fac_min, safety * (tol/err)^(1/q)))`` with ``q = p``
+(the order: ``err ~ h^p`` per unit time) for ``h >= UNIT_STEP`` and ``q = p + 1`` below,
+``fac_min = 0.2`` and ``fac_max = 2`` (variable-step BDF2 is zero-stable for step ratios
+below 1 + sqrt 2); no growth on the step right after a rejection, a cut by ``fac_min`` on a
+second consecutive rejection of the same step (the estimate is then not asymptotic, as
+when the contact edge sweeps over an element), and a growth factor below ``hold = 1.5``
+keeps ``dt`` (a new ``dt`` makes the gmres solver refactor its preconditioner, and a
+steady ``dt`` keeps the estimate smooth).  ``dt`` stays in ``[dt_min, dt_max]``.  When
+steady (``err -> 0``) steps grow by ``fac_max`` up to ``dt_max``.
 
 Start, breakpoints and restarts
 -------------------------------
 The first step has no history: it is a backward-Euler step (the scheme's own first step)
 of size ``dt0``.  Its error ``h1^2 y''/2`` is judged after the second step, from the
 second difference of the three levels: with ``d_lin`` the linear extrapolation of
-``d0, d1`` to ``t2``, ``err_1 = h1^2 / (h2 (h1 + h2)) * |d2 - d_lin|`` in the norm above.
+``d0, d1`` to ``t2``, ``LTE_1 = h1^2 / (h2 (h1 + h2)) * |d2 - d_lin|`` in the norm above
+(``err_1 = LTE_1 / max(h1, UNIT_STEP)``, order p = 1 in the controller).
 The pair (Euler step, first BDF2 step) is accepted or rejected together on ``err_1``
 (the step-1 state is yielded only then), and ``err_1`` is the ``error_estimate`` of both.
 Steps never cross a breakpoint of the motion (:attr:`femehl.scene.Motion.breakpoints`:
@@ -64,8 +76,9 @@ A trial step that raises :class:`~femehl.errors.FilmRuptureError` or
 :class:`~femehl.errors.SingularSystemError`, or whose film is <= 0 anywhere
 (:func:`femehl.stepping.film_positive`: film points, origin, probed nodes), is rejected
 and retried with ``dt/4``.  Below ``dt_min`` the run stops with a FilmRuptureError that
-tells apart a film that closes (it decreased steadily at that place over the last
-accepted steps, at a rate reaching zero within a few steps: solid contact) from a step
+tells apart a film that closes (it decreased at that place over each of the last
+accepted steps, at a rate reaching zero within CLOSE_STEPS = 3 steps, or it is already
+below THIN_FILM = 1e-4 times the initial thinnest film: solid contact) from a step
 floor reached while the film was not closing.  An error estimate that stays above ``tol``
 at ``dt_min`` stops the run the same way (a :class:`~femehl.errors.SolverError` when the
 film is not closing).
@@ -363,9 +376,10 @@ def march_adaptive(
     t_end : float
         End time; the last step lands on it.
     tol : float
-        Relative local error per step, in the norm of the module docstring (0 < tol < 1).
+        Relative local error per unit time, in the norm of the module docstring (0 < tol < 1);
+        the global error of load and films is then about tol or below.
     dt0 : float, optional
-        First step and the step after each breakpoint; default ``0.05 sqrt(tol)``.
+        First step and the step after each breakpoint; default ``0.05 tol``.
     dt_min, dt_max : float, optional
         Step floor and ceiling; default ``1e-6`` and ``0.1`` times the run's span.
     start : State, optional
@@ -374,9 +388,9 @@ def march_adaptive(
         The controller's safety factor.
     """
     t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
-    tol = check_positive("tol", tol, "Give a relative error per step, e.g. 1e-3.")
+    tol = check_positive("tol", tol, "Give a relative error per unit time, e.g. 1e-3.")
     if tol >= 1.0:
-        raise SceneError(f"tol = {tol:g} is a relative error per step: use tol < 1 (e.g. 1e-3).")
+        raise SceneError(f"tol = {tol:g} is a relative error per unit time: use tol < 1 (e.g. 1e-3).")
     safety = check_positive("safety", safety)
     if safety > 1.0:
         raise SceneError(f"safety = {safety:g} must be in (0, 1] (0.9 is usual).")
@@ -439,7 +453,7 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
     remaining = stop - base.t
     start_step = len(run.levels) == 1
     if start_step:  # the Euler start step leaves room for the second step of its pair
-        h = remaining if remaining <= 2.0 * dt_min else min(run.dt, dt_max, 0.5 * remaining)
+        h = min(run.dt, remaining) if remaining <= 2.0 * dt_min else min(run.dt, dt_max, 0.5 * remaining)
     else:
         h = _next_h(min(run.dt, dt_max), remaining)
     t_new = stop if h == remaining else base.t + h

@@ -86,6 +86,11 @@ class Constant:
     def __call__(self, t: float) -> float:
         return self.value
 
+    @property
+    def breakpoints(self) -> tuple:
+        """Times where the function or its derivative jumps: none."""
+        return ()
+
 
 @dataclass(frozen=True)
 class Table:
@@ -134,6 +139,11 @@ class Table:
     def __call__(self, t: float) -> float:
         return float(np.interp(t, self.times, self.values))
 
+    @property
+    def breakpoints(self) -> tuple:
+        """Times where the slope may jump: the sample times."""
+        return tuple(self.times)
+
 
 @dataclass(frozen=True)
 class RampHold:
@@ -155,6 +165,11 @@ class RampHold:
         s = min(max(t / self.t1, 0.0), 1.0)
         return self.h0 + (self.h_end - self.h0) * s
 
+    @property
+    def breakpoints(self) -> tuple:
+        """Times where the slope jumps: the end of the ramp ``t1``."""
+        return (self.t1,)
+
 
 @dataclass(frozen=True)
 class TanhStart:
@@ -171,6 +186,11 @@ class TanhStart:
 
     def __call__(self, t: float) -> float:
         return 0.0 if t < self.t1 else self.V_ss * math.tanh((t - self.t1) / self.T)
+
+    @property
+    def breakpoints(self) -> tuple:
+        """Times where the slope jumps: the start of sliding ``t1``."""
+        return (self.t1,)
 
 
 #: Accepted rise max(s) - min(s) of the indenter's gap across the domain (units of h_inf).
@@ -250,6 +270,20 @@ class Motion:
     def load_controlled(self) -> bool:
         """True when the load F(t) is imposed and hc(t) is an unknown (gap gives hc(0))."""
         return self.load is not None
+
+    @property
+    def breakpoints(self) -> tuple:
+        """Sorted times where a history (or its slope) jumps: the ``breakpoints`` of the
+        velocity and of the gap (or, under imposed load, of the load: the gap then only
+        gives hc(0)).  A callable without a ``breakpoints`` attribute contributes none.
+        Adaptive time stepping (:mod:`femehl.core.adaptive`) lands on these times."""
+        funcs = [self.velocity, self.load if self.load_controlled else self.gap]
+        times = set()
+        for f in funcs:
+            for t in getattr(f, "breakpoints", ()) or ():
+                if isinstance(t, (int, float)) and math.isfinite(t):
+                    times.add(float(t))
+        return tuple(sorted(times))
 
     def F(self, t: float) -> float:
         """The imposed load F(t) (finite, >= 0: the lubricated contact cannot pull)."""

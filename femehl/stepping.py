@@ -19,7 +19,8 @@ import numpy as np
 
 from .errors import FilmRuptureError, SceneError
 
-__all__ = ["State", "Stepper", "march", "check_run", "Scheme", "SCHEMES", "get_scheme"]
+__all__ = ["State", "Stepper", "march", "check_run", "Scheme", "SCHEMES", "get_scheme", "film_floor",
+           "film_positive"]
 
 
 @dataclass(frozen=True)
@@ -145,6 +146,19 @@ def _film_floor(state: State):
         cands.append((state.info["node_film_min"], tuple(state.info["node_film_min_at"]), "a node"))
     bad = [c for c in cands if not math.isfinite(c[0])]
     return bad[0] if bad else min(cands, key=lambda c: c[0])
+
+
+def film_floor(state: State) -> tuple:
+    """``(d, (x, y), where)``: the thinnest (or a non-finite) film of ``state`` and its place."""
+    d, at, where = _film_floor(state)
+    return d, tuple(at), where
+
+
+def film_positive(state: State) -> bool:
+    """True when every film ``state`` knows of is finite and > 0 (the test of
+    :func:`_check_film`, without raising)."""
+    d = _film_floor(state)[0]
+    return math.isfinite(d) and d > 0.0
 
 
 def _check_film(state: State):

@@ -77,7 +77,8 @@ def solve(
     method: str | None = None,
     *,
     t_end: float = 5.0,
-    dt: float = 0.01,
+    dt: float | None = None,
+    tol: float | None = None,
     store_every: int = 1,
     callback: Callable[[State], None] | None = None,
     **options,
@@ -94,50 +95,82 @@ def solve(
         contact, the default for a :class:`femehl.line.LineScene`).
     t_end : float, default: 5.0
         End time (normalized).
-    dt : float, default: 0.01
-        Time step (the paper's value).
+    dt : float, optional
+        Fixed time step (default 0.01, the paper's value); with ``tol``, the first step.
+    tol : float, optional
+        Adaptive time steps (:mod:`femehl.core.adaptive`) to this relative local error
+        per unit time; the scheme is then BDF2 unless given.  ``dt_min``, ``dt_max`` and
+        ``safety`` tune the controller.
     store_every : int, default: 1
         Keep the fields of every ``store_every``-th step (and the last); 0 keeps none.
     callback : callable, optional
         Called with each State as it is produced (progress bars, writers).
     **options
-        Discretization options of the method: FD ``dr``, ``dtheta``; FE ``mesh``, ...
+        Options of the method (FD ``dr``, ``dtheta``; FE ``mesh``; line ``n_elements``)
+        and of the stepper (``scheme``, ``linear_solver``, ``terms``, ...).
     """
+    from .core.adaptive import CONTROLS
     from .stepping import check_run
 
-    check_run(t_end, dt)
+    controls = {k: options.pop(k) for k in CONTROLS if k in options}
+    if tol is None:
+        dt = 0.01 if dt is None else dt
+        check_run(t_end, dt)
+    else:
+        options.setdefault("scheme", "bdf2")
     stepper = make_stepper(scene, method, **options)
-    return run_loop(stepper, t_end, dt, store_every=store_every, on_state=callback)
+    return run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
 
 
 def run_loop(
     stepper,
     t_end: float,
-    dt: float,
+    dt: float | None = None,
     *,
+    tol: float | None = None,
     start: State | None = None,
     store_every: int = 1,
     on_state: Callable[[State], None] | None = None,
+    **controls,
 ) -> Result:
     """The one driver loop: march ``stepper`` and feed every State to a Result and ``on_state``.
 
     Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
-    here.  ``start`` resumes from a State (its own record is kept, ``on_state`` is not
-    called for it).  If the run stops on a :class:`~femehl.errors.SolverError` or is
-    interrupted, the partial Result is attached to the exception as ``.result`` and
-    the exception propagates; everything fed to ``on_state`` before stays valid.
+    here.  Fixed steps ``dt`` (:func:`femehl.stepping.march`), or adaptive steps to
+    ``tol`` (:func:`femehl.core.adaptive.march_adaptive`, ``dt`` the first step, ``controls``
+    its ``dt_min``, ``dt_max``, ``safety``).  ``start`` resumes from a State (its own
+    record is kept, ``on_state`` is not called for it).  If the run stops on a
+    :class:`~femehl.errors.SolverError` or is interrupted, the partial Result is attached
+    to the exception as ``.result`` and the exception propagates; everything fed to
+    ``on_state`` before stays valid.
     """
+    import math
+
     from .errors import SolverError
 
     if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
         raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
+    if tol is None:
+        if controls:
+            raise SceneError(f"{sorted(controls)} tune adaptive steps: give tol= as well.")
+        states = march(stepper, t_end, 0.01 if dt is None else dt, start=start)
+    else:
+        from .core.adaptive import march_adaptive
+
+        if dt is not None:
+            controls.setdefault("dt0", dt)
+        states = march_adaptive(stepper, t_end, tol=tol, start=start, **controls)
     result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
     last = None
+    rejected, dts = 0, []
     try:
-        for state in march(stepper, t_end, dt, start=start):
+        for state in states:
             keep = store_every > 0 and state.step % store_every == 0
             result.record(state, store_fields=keep)
-            if on_state is not None and state is not start:
+            rejected += state.info.get("rejected", 0)
+            if state.info.get("dt", 0.0) > 0.0:
+                dts.append(state.info["dt"])
+            if on_state is not None and (start is None or last is not None):
                 on_state(state)
             last = (state, keep)
     except (SolverError, KeyboardInterrupt) as exc:
@@ -148,6 +181,13 @@ def run_loop(
             result._stored.append(last[0])
         result.info.update(getattr(stepper, "info", {}))  # counters as at the end of the run
         result.info["steps"] = result.nsteps
+        if tol is not None:
+            result.info.update(
+                tol=tol,
+                rejected_steps=rejected,
+                dt_smallest=min(dts, default=math.nan),
+                dt_largest=max(dts, default=math.nan),
+            )
     return result
 
 

@@ -19,8 +19,17 @@ import numpy as np
 
 from .errors import FilmRuptureError, SceneError
 
-__all__ = ["State", "Stepper", "march", "check_run", "Scheme", "SCHEMES", "get_scheme", "film_floor",
-           "film_positive"]
+__all__ = [
+    "State",
+    "Stepper",
+    "march",
+    "check_run",
+    "Scheme",
+    "SCHEMES",
+    "get_scheme",
+    "film_floor",
+    "film_positive",
+]
 
 
 @dataclass(frozen=True)
@@ -136,8 +145,11 @@ def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None)
         yield state
 
 
-def _film_floor(state: State):
-    """The thinnest film the step knows of, and where: film points, origin, probed nodes."""
+def film_floor(state: State) -> tuple:
+    """``(d, (x, y), where)``: the thinnest (or a non-finite) film ``state`` knows of.
+
+    Candidates: the film points, the origin (the central film) and the probed nodes.
+    """
     cands = [
         (state.film_min, tuple(state.film_min_at), "the film points"),
         (state.film_center, (0.0, 0.0), "the origin"),
@@ -148,28 +160,23 @@ def _film_floor(state: State):
     return bad[0] if bad else min(cands, key=lambda c: c[0])
 
 
-def film_floor(state: State) -> tuple:
-    """``(d, (x, y), where)``: the thinnest (or a non-finite) film of ``state`` and its place."""
-    d, at, where = _film_floor(state)
-    return d, tuple(at), where
-
-
 def film_positive(state: State) -> bool:
     """True when every film ``state`` knows of is finite and > 0 (the test of
     :func:`_check_film`, without raising)."""
-    d = _film_floor(state)[0]
+    d = film_floor(state)[0]
     return math.isfinite(d) and d > 0.0
 
 
 def _check_film(state: State):
-    d, (x, y), where = _film_floor(state)
-    if not (math.isfinite(d) and d > 0.0):
-        raise FilmRuptureError(
-            f"film thickness reached {d:.3g} <= 0 at t = {state.t:.6g}, at {where} "
-            f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
-            "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
-            "load truly squeezes the film out, the lubricated model no longer applies.",
-            t=state.t,
-            where=(x, y),
-            d_min=d,
-        )
+    if film_positive(state):
+        return
+    d, (x, y), where = film_floor(state)
+    raise FilmRuptureError(
+        f"film thickness reached {d:.3g} <= 0 at t = {state.t:.6g}, at {where} "
+        f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
+        "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
+        "load truly squeezes the film out, the lubricated model no longer applies.",
+        t=state.t,
+        where=(x, y),
+        d_min=d,
+    )

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl.api import make_stepper, run_loop
-from femehl.core.adaptive import StepController, march_adaptive, run_adaptive, solve_adaptive
+from femehl.api import make_stepper, run_loop, solve
+from femehl.core.adaptive import StepController, march_adaptive
 from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
 from femehl.line import LineScene
 from femehl.stepping import SCHEMES, State, film_positive
@@ -271,7 +271,7 @@ def test_line_contact_against_fine_fixed_step(line_reference, tol):
     tol 1e-3: 215 steps, 1 rejected, load 2.9e-4, film_min 2.9e-4
     (fixed dt = 0.01, 200 steps: load 9.3e-4, film_min 2.8e-5).
     """
-    res = solve_adaptive(LineScene(), 2.0, tol, store_every=0)
+    res = solve(LineScene(), t_end=2.0, tol=tol, store_every=0)
     assert res.t[-1] == 2.0 and 1.0 in res.t
     load, fmin = _errors(res, line_reference)
     assert load < tol and fmin < tol, (load, fmin)
@@ -289,7 +289,7 @@ def test_paper_sphere_coarse_against_fine_fixed_step(fe_reference, tol):
     is ~tol, not below: tol bounds the error per unit time, and film_min follows the
     thinnest element, whose film has sharp (under-resolved) turns on the coarse mesh.
     """
-    res = solve_adaptive(femehl.presets.paper_sphere(), 2.0, tol, method="fe", mesh="coarse", store_every=0)
+    res = solve(femehl.presets.paper_sphere(), "fe", t_end=2.0, tol=tol, mesh="coarse", store_every=0)
     assert res.t[-1] == 2.0 and 1.0 in res.t
     load, fmin = _errors(res, fe_reference)
     assert load < tol and fmin < 1.5 * tol, (load, fmin)
@@ -297,7 +297,7 @@ def test_paper_sphere_coarse_against_fine_fixed_step(fe_reference, tol):
 
 def test_store_every_and_callback():
     seen = []
-    res = solve_adaptive(LineScene(), 1.0, 1e-2, store_every=5, callback=seen.append)
+    res = solve(LineScene(), t_end=1.0, tol=1e-2, store_every=5, callback=seen.append)
     assert len(seen) == res.nsteps + 1
     assert res.stored_times[-1] == 1.0
     assert all(s.step % 5 == 0 for s in res.states[:-1])
@@ -319,7 +319,7 @@ def test_stiff_scene_rejects_and_retries(caplog):
     stepper = make_stepper(scene, "fe", mesh="coarse", scheme="bdf2")
     with caplog.at_level(logging.DEBUG, logger="femehl"):
         with pytest.raises(SolverError) as adaptive:
-            run_adaptive(stepper, 2.0, tol=0.3, dt_max=0.05, dt_min=1e-4, store_every=0)
+            run_loop(stepper, 2.0, tol=0.3, dt_max=0.05, dt_min=1e-4, store_every=0)
     exc = adaptive.value
     assert isinstance(exc, FilmRuptureError) and exc.reason == "closes"
     assert "the film closes (solid contact)" in str(exc)

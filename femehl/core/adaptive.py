@@ -95,7 +95,7 @@ import dataclasses
 import logging
 import math
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -104,7 +104,7 @@ from ..errors import FilmRuptureError, SceneError, SingularSystemError, SolverEr
 from ..stepping import State, film_floor, film_positive
 from ..validation import check_positive
 
-__all__ = ["StepController", "march_adaptive", "run_adaptive", "solve_adaptive", "breakpoints_of"]
+__all__ = ["StepController", "march_adaptive", "breakpoints_of", "CONTROLS"]
 
 logger = logging.getLogger("femehl")
 
@@ -119,7 +119,8 @@ THIN_FILM = 1e-4
 LOAD_FLOOR = 0.1
 #: the local error is per unit time for steps longer than UNIT_STEP, per UNIT_STEP below
 UNIT_STEP = 0.01
-_ADAPTIVE_KEYS = ("dt0", "dt_min", "dt_max", "safety", "start")
+#: keyword arguments of :func:`march_adaptive` that tune the controller
+CONTROLS = ("dt0", "dt_min", "dt_max", "safety")
 
 
 @dataclass(frozen=True)
@@ -513,79 +514,3 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
 
 
 # ---- drivers ------------------------------------------------------------------------------
-def run_adaptive(
-    stepper,
-    t_end: float,
-    *,
-    tol: float,
-    start: State | None = None,
-    store_every: int = 1,
-    on_state: Callable[[State], None] | None = None,
-    **controls,
-):
-    """:func:`femehl.api.run_loop` with adaptive steps: march and record into a Result.
-
-    ``controls`` are ``dt0``, ``dt_min``, ``dt_max``, ``safety`` of :func:`march_adaptive`.
-    Fields are kept for every ``store_every``-th accepted step and the last.  On a
-    :class:`~femehl.errors.SolverError` or an interruption the partial Result is attached
-    to the exception as ``.result``.  ``result.info`` gets ``tol``, ``rejected_steps`` and
-    the step sizes ``dt_smallest``, ``dt_largest``.
-    """
-    from ..result import Result
-
-    if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
-        raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
-    result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
-    last = None
-    rejected = 0
-    dts = []
-    try:
-        for state in march_adaptive(stepper, t_end, tol=tol, start=start, **controls):
-            keep = store_every > 0 and state.step % store_every == 0
-            result.record(state, store_fields=keep)
-            rejected += state.info.get("rejected", 0)
-            if state.info.get("dt", 0.0) > 0.0:
-                dts.append(state.info["dt"])
-            if on_state is not None and (start is None or last is not None):
-                on_state(state)
-            last = (state, keep)
-    except (SolverError, KeyboardInterrupt) as exc:
-        exc.result = result
-        raise
-    finally:
-        if last is not None and store_every > 0 and not last[1]:
-            result._stored.append(last[0])
-        result.info.update(getattr(stepper, "info", {}))
-        result.info.update(
-            steps=result.nsteps,
-            tol=tol,
-            rejected_steps=rejected,
-            dt_smallest=min(dts, default=math.nan),
-            dt_largest=max(dts, default=math.nan),
-        )
-    return result
-
-
-def solve_adaptive(
-    scene,
-    t_end: float,
-    tol: float,
-    method: str | None = None,
-    store_every: int = 1,
-    callback: Callable[[State], None] | None = None,
-    **options,
-):
-    """Run ``scene`` from t = 0 to ``t_end`` with adaptive steps; return a Result.
-
-    Like :func:`femehl.api.solve` with ``tol`` instead of ``dt``: the stepper is built by
-    :func:`femehl.api.make_stepper` (``scheme="bdf2"`` unless given) from the method's
-    options; ``dt0``, ``dt_min``, ``dt_max``, ``safety`` go to :func:`march_adaptive`.
-    """
-    from ..api import make_stepper
-
-    controls = {k: options.pop(k) for k in _ADAPTIVE_KEYS if k in options}
-    if "start" in controls:
-        raise SceneError("solve_adaptive starts at t = 0; resume with run_adaptive(stepper, start=...).")
-    options.setdefault("scheme", "bdf2")
-    stepper = make_stepper(scene, method, **options)
-    return run_adaptive(stepper, t_end, tol=tol, store_every=store_every, on_state=callback, **controls)

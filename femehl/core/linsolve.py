@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -82,8 +83,9 @@ class StepOperator:
     def dense(self) -> bool:
         return isinstance(self.C, np.ndarray)
 
+    @cached_property
     def G(self):
-        """``sum_i c_i F_i`` (sparse, n x film points)."""
+        """``sum_i c_i F_i`` (sparse, n x film points), formed once per step."""
         G = None
         for c, F, _ in self.films:
             G = F * c if G is None else G + F * c
@@ -113,7 +115,7 @@ class StepOperator:
 
     def apply(self, Z, CZ, G=None):
         """``A Z`` for columns ``Z`` whose ``C Z`` is known: sparse work only."""
-        G = self.G() if G is None else G
+        G = self.G if G is None else G
         return self.D @ Z + G @ CZ
 
 
@@ -267,7 +269,7 @@ class RecycledGCR:
             self.residuals = self.direct.residuals
             self._sync()
             return out
-        G = op.G()
+        G = op.G
         return [self._solve_one(op, G, b, t) for b in rhs]
 
     def _sync(self):

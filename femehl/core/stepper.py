@@ -217,7 +217,7 @@ class LaggedStepper:
             t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
         )
         op, rhs = self.operator(ctx)
-        G = op.G()
+        G = op.G
         if mo.load_controlled:
             F = mo.F(t_new)
             ones = np.ones(self.shape.size)

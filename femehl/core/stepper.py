@@ -108,13 +108,13 @@ class LaggedStepper:
                 "terms": [t.name for t in self.terms],
                 "elastic_build_s": t2 - t1,
                 "operator_bytes": int(_nbytes(self.C)),
-                "couette_assembled": False,
+                **{f"{t.name}_assembled": False for t in self.terms},
                 "factorizations": 0,
                 "krylov_iterations": 0,
             }
         )
-        for term in self.terms:  # the film products every step needs are formed once
-            if term.name == "squeeze":
+        for term in self.terms:  # film products every step needs: formed here, once
+            if getattr(term, "every_step", False):
                 self._film_product(term)
         self.info["setup_s"] = disc.info.get("setup_s", 0.0) + time.perf_counter() - t0
 
@@ -127,8 +127,7 @@ class LaggedStepper:
             FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
             self._FC[term.name] = FC
             self.info["operator_bytes"] += _nbytes(FC)
-            if term.name == "couette":
-                self.info["couette_assembled"] = True
+            self.info[f"{term.name}_assembled"] = True
         return FC
 
     def operator(self, ctx: StepContext):

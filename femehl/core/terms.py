@@ -167,6 +167,7 @@ class Squeeze:
     """``dd/dt`` by the scheme's backward difference: ``T (a0 d^{k+1} - history) / dt``."""
 
     name = "squeeze"
+    every_step = True  # its film product F C is formed with the operators, before the first step
 
     @staticmethod
     def applies(scene, t_end=None):

@@ -98,6 +98,7 @@ __all__ = [
     "check_mesh_memory",
     "estimate_elements",
     "graded_disk",
+    "sized_disk",
     "ladder_path",
     "load_mesh",
     "machine_memory",
@@ -440,7 +441,24 @@ def graded_disk(
             "mesh sizes"
         )
     check_mesh_memory(int(ne), int(ne / 2), f"graded_disk(L={L:g}, ...) (estimated)")
-    p, t, on_arc, on_line = _gmsh_disk(L, bool(half), h)
+    return sized_disk(L, bool(half), lambda x, y: h(math.hypot(x, y)), name)
+
+
+def sized_disk(L: float, half: bool, size, name: str = "generated") -> DiskMesh:
+    """Mesh the (half) disk of radius ``L`` with gmsh under the size field ``size(x, y)``.
+
+    The machinery of :func:`graded_disk` (same gmsh options: Frontal-Delaunay, one
+    thread, fixed seed) for any scalar size function of the position, e.g. the
+    scene-fitted fields of :mod:`femehl.fe.fitted`.  The caller guards the element
+    count (:data:`MAX_GMSH_ELEMENTS`, :func:`check_mesh_memory`) before calling.
+
+    Returns
+    -------
+    DiskMesh
+        Checked as by :func:`load_mesh`; boundary nodes exactly on ``r = L`` / ``y = 0``.
+    """
+    L = float(L)
+    p, t, on_arc, on_line = _gmsh_disk(L, bool(half), size)
     # Exact boundary: arc nodes onto r = L, mirror-line nodes onto y = 0.
     r = np.hypot(p[0, on_arc], p[1, on_arc])
     p[:, on_arc] *= L / r
@@ -464,7 +482,8 @@ _GMSH_OPTIONS = {
 
 
 def _gmsh_disk(L, half, h):
-    """Run gmsh; return nodes (2, n), triangles (3, ne), masks of arc / line nodes."""
+    """Run gmsh under the size field ``h(x, y)``; return nodes (2, n), triangles (3, ne),
+    masks of arc / line nodes."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -499,7 +518,7 @@ def _gmsh_disk(L, half, h):
         geo.synchronize()
         if not half:
             gmsh.model.mesh.embed(0, [c], 2, surf)  # a node at the origin
-        gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, lc: h(math.hypot(x, y)))
+        gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, lc: h(x, y))
         gmsh.model.mesh.generate(2)
 
         tags, coords, _ = gmsh.model.mesh.getNodes()

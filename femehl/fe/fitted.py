@@ -103,7 +103,7 @@ C_FAR = 0.152
 A_FLOOR = 0.05
 
 # polar sampling of the gap: rays, radial samples, Gauss points of the Sneddon integrals
-_NTH, _NR, _NPHI = 192, 1201, 48
+_NTH, _NR, _NPHI = 96, 801, 48
 
 
 # ---------------------------------------------------------------------------
@@ -287,7 +287,7 @@ def contact_extent(scene, t_end: float) -> tuple[float, float]:
       foundation has no lateral spreading); Winkler load ``F = k int (delta - s)+ dA``;
       a rigid substrate is never indented under load: ``(0, 0)``.
 
-    The shape is sampled on a polar grid (192 rays, 1201 radii out to
+    The shape is sampled on a polar grid (96 rays, 801 radii out to
     ``min(1.5 L, map extent)``) as ``Scene._check_domain_holds_contact`` does.
 
     Returns

@@ -34,6 +34,10 @@ has about twice the elements of the one before (half disk, ``L = 2``: about
 nodes are placed exactly on the circle ``r = L`` and on the mirror line
 ``y = 0``; the origin is always a node.
 
+:func:`sized_disk` is the same mesher under any size field ``h(x, y)``; the
+scene-fitted meshes of :mod:`femehl.fe.fitted` (``fitted_disk(scene, t_end)``,
+refined at the contact of that scene) use it.
+
 The ladder is shipped as gmsh files ``meshes/half_<name>.msh`` and
 ``meshes/full_<name>.msh`` in the repository; regenerate them with::
 

@@ -259,3 +259,18 @@ def test_solver_runs_on_a_fitted_mesh(tmp_path):
     dm = fitted_disk(sc, 0.6, level=2.1, cache_dir=tmp_path)
     res = femehl.solve(sc, t_end=0.6, dt=0.05, mesh=dm, store_every=0)
     assert np.isfinite(res.film_min[-1]) and res.load[-1] > 0
+
+
+def test_load_mesh_names_the_fitted_fix():
+    with pytest.raises(MeshError, match="fitted_disk"):
+        load_mesh("fitted")
+
+
+def test_heightmap_extent():
+    """A sampled sphere (HeightMap) goes through the Sneddon route: a = 1 to 1 %."""
+    from femehl.indenters import HeightMap
+
+    g = np.linspace(-3.0, 3.0, 241)
+    X, Y = np.meshgrid(g, g, indexing="ij")
+    sc = Scene(indenter=HeightMap(g, g, (X**2 + Y**2) / 2), motion=Motion(gap=RampHold(0.1, -1.0)))
+    assert contact_extent(sc, 2.0) == pytest.approx((1.0, 1.0), rel=1e-2)

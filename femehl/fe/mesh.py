@@ -628,6 +628,11 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
         p, t, h = _normalize(p, t, L, half, "<MeshTri>")
         return DiskMesh(_make_meshtri(p, t), float(L), h, "<MeshTri>")
 
+    if isinstance(spec, str) and spec == "fitted" and not pathlib.Path(spec).exists():
+        raise MeshError(
+            "mesh 'fitted' depends on the scene: pass mesh=femehl.fe.fitted.fitted_disk(scene, "
+            "t_end) (a DiskMesh refined at that scene's contact) instead of the name"
+        )
     if isinstance(spec, str) and spec in LADDER:
         half = True if half is None else bool(half)
         _check_l(L)

@@ -5,7 +5,8 @@ Scenes (FE, BDF2, dt = 0.01, to t = 3, half disk: all are symmetric in y):
 * ``ellipsoid``: the shipped example (``examples/ellipsoid_sliding.py``),
   Ellipsoid(Rx = 0.5, Ry = 2), hc -> -0.5, beta = 200;
 * ``ellipsoid_x``: the same turned by 90 degrees, Rx = 2, Ry = 0.5;
-* ``sphere``: the paper sphere (``femehl.presets.paper_sphere()``).
+* ``sphere``: the paper sphere (``femehl.presets.paper_sphere()``);
+* ``sphere_b2000``: the same at beta = 2000 (films 5x thinner: the edge band narrows).
 
 Each is run on the ladder meshes and on ``fitted_disk(scene, 3, level)`` for
 levels ``1.45^2, 1.45, 1, 1/1.45`` (each level has about twice the elements of
@@ -70,7 +71,10 @@ SCENES = {
     "ellipsoid (Rx=0.5, Ry=2)": ellipsoid(0.5, 2.0),
     "ellipsoid_x (Rx=2, Ry=0.5)": ellipsoid(2.0, 0.5),
     "sphere (paper)": femehl.presets.paper_sphere(),
+    "sphere (paper, beta=2000)": femehl.presets.paper_sphere(beta=2000.0),
 }
+#: --scenes keys -> SCENES labels
+KEYS = dict(zip(("ellipsoid", "ellipsoid_x", "sphere", "sphere_b2000"), SCENES, strict=True))
 
 
 def run(scene, mesh, dt=DT, t_end=T_END):
@@ -102,9 +106,10 @@ def richardson(values, p=2.0):
     return f_inf, p_obs
 
 
-def mesh_study(ladder, levels):
+def mesh_study(ladder, levels, keys):
     rows = []
-    for label, scene in SCENES.items():
+    for label in (KEYS[k] for k in keys):
+        scene = SCENES[label]
         ax, ay = contact_extent(scene, T_END)
         print(f"\n{label}: contact semi-axes ax = {ax:.4f}, ay = {ay:.4f}", flush=True)
         recs = []
@@ -255,10 +260,14 @@ def main():
     ap.add_argument("--no-zone", action="store_true", help="skip the exit-zone study")
     ap.add_argument("--out", default=str(HERE / "fitted_mesh.md"))
     ap.add_argument("--analyze-only", action="store_true", help="rebuild the table from the .json")
+    ap.add_argument("--scenes", default=",".join(KEYS), help=f"comma-separated, of {', '.join(KEYS)}")
+    ap.add_argument("--merge", nargs="*", default=[], help="with --analyze-only: more .json to add")
     a = ap.parse_args()
     raw = pathlib.Path(a.out).with_suffix(".json")
     if a.analyze_only:
         data = json.loads(raw.read_text())
+        for extra in a.merge:
+            data["rows"] += json.loads(pathlib.Path(extra).read_text())["rows"]
         rows = [(r[0], r[1], r[2], r[-1]) for r in data["rows"]]  # (label, ax, ay, runs)
         text = report(rows, data.get("zone", []), data.get("quick", False))
         print(text)
@@ -267,7 +276,7 @@ def main():
     r = LADDER_RATIO
     ladder = ["coarse", "medium"] if a.quick else ["coarse", "medium", "fine"] + ["xfine"] * a.xfine
     levels = [r * r, r] if a.quick else [r * r, r, 1.0, 1.0 / r]
-    rows = mesh_study(ladder, levels)
+    rows = mesh_study(ladder, levels, [k for k in a.scenes.split(",") if k])
     raw.write_text(json.dumps({"rows": rows, "quick": a.quick}, indent=1))
     zone = [] if (a.quick or a.no_zone) else exit_zone([20.0, 200.0, 2000.0])
     raw.write_text(json.dumps({"rows": rows, "zone": zone, "quick": a.quick}, indent=1))

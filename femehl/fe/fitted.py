@@ -290,8 +290,9 @@ def contact_extent(scene, t_end: float) -> tuple[float, float]:
     under an imposed load the depth at which the *dry* contact carries the
     largest ``F(t)`` (the film only adds a thin layer).  The contact at that depth:
 
-    * half space, :class:`~femehl.indenters.Ellipsoid` (and Sphere): Hertz
-      (:func:`hertz_ellipse`; sphere ``a = sqrt(R delta)``, ``F = 4 a^3/(3 pi cc)``);
+    * half space, a paraboloid (an indenter with ``curvature_radii()``: Sphere,
+      Ellipsoid): Hertz (:func:`hertz_ellipse`; sphere ``a = sqrt(R delta)``,
+      ``F = 4 a^3/(3 pi cc)``);
     * half space, any other shape: Sneddon's axisymmetric solution ray by ray
       (:class:`_RaySneddon`; exact for FlatPunch; a heuristic for a shape
       without axial symmetry), load the ray average;
@@ -318,11 +319,10 @@ def contact_extent(scene, t_end: float) -> tuple[float, float]:
     motion, sub, ind = scene.motion, scene.substrate, scene.indenter
     kind = getattr(sub, "kind", "halfspace")
     cc = float(getattr(sub, "compliance", 1.0))
-    ellipsoid = hasattr(ind, "Rx") and hasattr(ind, "Ry")
-    sphere = hasattr(ind, "R") and not ellipsoid
+    radii = getattr(ind, "curvature_radii", None)  # a paraboloid: Sphere, Ellipsoid
     th, r, S = _polar_gap(scene)
-    if kind == "halfspace" and (ellipsoid or sphere):
-        Rx, Ry = (ind.Rx, ind.Ry) if ellipsoid else (ind.R, ind.R)
+    if kind == "halfspace" and callable(radii):
+        Rx, Ry = (float(v) for v in radii())
 
         def axes(delta):
             return hertz_ellipse(Rx, Ry, delta)[:2]

@@ -191,6 +191,28 @@ def machine():
     )
 
 
+def _summary(rows):
+    """At the medium rung's element count: the closest fitted level's error vs the medium rung's."""
+    out = [
+        "## At the medium rung's element count",
+        "",
+        "| scene | ladder medium: elements, error | closest fitted level: elements, error |",
+        "|---|---|---|",
+    ]
+    for label, _ax, _ay, recs in rows:
+        ref, _p = richardson([f for kind, _n, _ne, _t, f, *_ in recs if kind == "fitted"])
+        med = [r for r in recs if r[0] == "ladder" and r[1] == "medium"]
+        if not med:
+            continue
+        ne_med = med[0][2]
+        fit = min((r for r in recs if r[0] == "fitted"), key=lambda r: abs(math.log(r[2] / ne_med)))
+        out.append(
+            f"| {label} | {ne_med}, {100 * (med[0][4] / ref - 1):+.2f} % | {fit[1]}: {fit[2]}, "
+            f"{100 * (fit[4] / ref - 1):+.2f} % |"
+        )
+    return out + [""]
+
+
 def report(rows, zone, quick):
     L = ["# Scene-fitted meshes vs the mesh ladder", ""]
     L.append(
@@ -229,6 +251,7 @@ def report(rows, zone, quick):
                 f"| {wall:.1f} | - |"
             )
         L.append("")
+    L += _summary(rows)
     if zone:
         L += [
             "## Exit zone against beta (edge-band width)",

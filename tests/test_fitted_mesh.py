@@ -274,3 +274,12 @@ def test_heightmap_extent():
     X, Y = np.meshgrid(g, g, indexing="ij")
     sc = Scene(indenter=HeightMap(g, g, (X**2 + Y**2) / 2), motion=Motion(gap=RampHold(0.1, -1.0)))
     assert contact_extent(sc, 2.0) == pytest.approx((1.0, 1.0), rel=1e-2)
+
+
+def test_too_many_elements_refused_before_gmsh(monkeypatch):
+    def no_gmsh(*args, **kw):
+        raise AssertionError("gmsh must not run")
+
+    monkeypatch.setattr(F, "sized_disk", no_gmsh)
+    with pytest.raises(MeshError, match="larger level"):
+        fitted_disk(SCENES["ellipsoid_y"], 3.0, level=1e-3, cache=False)

@@ -99,6 +99,10 @@ class Sphere:
         y = np.asarray(y, dtype=float)
         return (x * x + y * y) / (2.0 * self.R)
 
+    def curvature_radii(self) -> tuple[float, float]:
+        """Principal radii of curvature ``(Rx, Ry)`` at the tip: ``(R, R)`` (Hertz contact)."""
+        return self.R, self.R
+
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose R so that the gap's rise L^2/(2R) on the domain r <= L lies in ``rise``."""
         lo, hi = _radius_range(L, rise)
@@ -144,6 +148,10 @@ class Ellipsoid:
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         return x * x / (2.0 * self.Rx) + y * y / (2.0 * self.Ry)
+
+    def curvature_radii(self) -> tuple[float, float]:
+        """Principal radii of curvature ``(Rx, Ry)`` along x and y (Hertz elliptic contact)."""
+        return self.Rx, self.Ry
 
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose Rx, Ry so that the gap's rise on the domain r <= L lies in ``rise``."""

@@ -34,6 +34,10 @@ has about twice the elements of the one before (half disk, ``L = 2``: about
 nodes are placed exactly on the circle ``r = L`` and on the mirror line
 ``y = 0``; the origin is always a node.
 
+:func:`sized_disk` is the same mesher under any size field ``h(x, y)``; the
+scene-fitted meshes of :mod:`femehl.fe.fitted` (``fitted_disk(scene, t_end)``,
+refined at the contact of that scene) use it.
+
 The ladder is shipped as gmsh files ``meshes/half_<name>.msh`` and
 ``meshes/full_<name>.msh`` in the repository; regenerate them with::
 
@@ -98,6 +102,7 @@ __all__ = [
     "check_mesh_memory",
     "estimate_elements",
     "graded_disk",
+    "sized_disk",
     "ladder_path",
     "load_mesh",
     "machine_memory",
@@ -436,7 +441,24 @@ def graded_disk(
             "mesh sizes"
         )
     check_mesh_memory(int(ne), int(ne / 2), f"graded_disk(L={L:g}, ...) (estimated)")
-    p, t, on_arc, on_line = _gmsh_disk(L, bool(half), h)
+    return sized_disk(L, bool(half), lambda x, y: h(math.hypot(x, y)), name)
+
+
+def sized_disk(L: float, half: bool, size, name: str = "generated") -> DiskMesh:
+    """Mesh the (half) disk of radius ``L`` with gmsh under the size field ``size(x, y)``.
+
+    The machinery of :func:`graded_disk` (same gmsh options: Frontal-Delaunay, one
+    thread, fixed seed) for any scalar size function of the position, e.g. the
+    scene-fitted fields of :mod:`femehl.fe.fitted`.  The caller guards the element
+    count (:data:`MAX_GMSH_ELEMENTS`, :func:`check_mesh_memory`) before calling.
+
+    Returns
+    -------
+    DiskMesh
+        Checked as by :func:`load_mesh`; boundary nodes exactly on ``r = L`` / ``y = 0``.
+    """
+    L = float(L)
+    p, t, on_arc, on_line = _gmsh_disk(L, bool(half), size)
     # Exact boundary: arc nodes onto r = L, mirror-line nodes onto y = 0.
     r = np.hypot(p[0, on_arc], p[1, on_arc])
     p[:, on_arc] *= L / r
@@ -460,7 +482,8 @@ _GMSH_OPTIONS = {
 
 
 def _gmsh_disk(L, half, h):
-    """Run gmsh; return nodes (2, n), triangles (3, ne), masks of arc / line nodes."""
+    """Run gmsh under the size field ``h(x, y)``; return nodes (2, n), triangles (3, ne),
+    masks of arc / line nodes."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -495,7 +518,7 @@ def _gmsh_disk(L, half, h):
         geo.synchronize()
         if not half:
             gmsh.model.mesh.embed(0, [c], 2, surf)  # a node at the origin
-        gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, lc: h(math.hypot(x, y)))
+        gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, lc: h(x, y))
         gmsh.model.mesh.generate(2)
 
         tags, coords, _ = gmsh.model.mesh.getNodes()
@@ -601,6 +624,11 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
         p, t, h = _normalize(p, t, L, half, "<MeshTri>")
         return DiskMesh(_make_meshtri(p, t), float(L), h, "<MeshTri>")
 
+    if isinstance(spec, str) and spec == "fitted" and not pathlib.Path(spec).exists():
+        raise MeshError(
+            "mesh 'fitted' depends on the scene: pass mesh=femehl.fe.fitted.fitted_disk(scene, "
+            "t_end) (a DiskMesh refined at that scene's contact) instead of the name"
+        )
     if isinstance(spec, str) and spec in LADDER:
         half = True if half is None else bool(half)
         _check_l(L)

@@ -1,0 +1,560 @@
+"""Meshes fitted to the scene: refined where the contact of *this* run is.
+
+The mesh ladder (:data:`femehl.fe.mesh.LADDER`) is graded for the paper sphere's
+contact annulus ``0.8 <= r <= 1.2``.  Another indenter puts its contact edge
+elsewhere: the shipped ellipsoid (``Rx = 0.5, Ry = 2, hc = -0.5``) has a contact
+semi-axis 0.44 along x and its exit minimum film near ``x = -0.5``, inside the
+ladder's coarse contact zone, and the ``medium`` rung is 11-13 % low in the
+minimum film at ``t = 3``.  This module meshes the disk from the scene itself::
+
+    from femehl.fe.fitted import fitted_disk
+    res = femehl.solve(scene, t_end=5.0, mesh=fitted_disk(scene, 5.0), scheme="bdf2")
+
+Two steps
+---------
+:func:`contact_extent` estimates the largest dry-contact semi-axes ``(ax, ay)``
+of the run (Hertz / Sneddon / Winkler, see there).  :func:`fitted_sizes` turns
+them into a size field, :func:`fitted_disk` meshes it with gmsh through
+:func:`femehl.fe.mesh.sized_disk` (the ladder's mesher and options) and caches
+the result on disk.
+
+The size field
+--------------
+The contact is modelled as the ellipse ``rho(x, y) = 1`` with
+``rho = sqrt((x/ax)^2 + (y/ay)^2)``.  Its local normal length scale is
+``ell(x, y) = 1/|grad rho|`` (constant along rays; ``ax`` on the x axis, ``ay``
+on the y axis, in ``[min(ax, ay), max(ax, ay)]``), and ``dn = (rho - 1) ell``
+approximates the signed distance to the contact edge (exact on the axes).
+With ``a_min = min(ax, ay)`` and sizes multiplied by ``level``:
+
+* contact zone ``rho <= 1.3``: ``h_contact = 0.095 a_min`` (the ``medium``
+  rung's 0.095 for the unit sphere; ``a_min`` because the triangles are
+  isotropic and must resolve the short axis);
+* edge band ``|dn| <= w``, ``w = W(beta) ell``: ``h_edge = 0.2035 w`` (about
+  ten elements across the band ``2 w``; ``0.0407`` at ``beta = 200``, the
+  ``medium`` rung's edge size), growing linearly to ``h_contact`` over
+  ``0.15 ell`` on either side (the ladder's transition);
+* far field: linear along each ray from ``h_contact`` on ``rho = 1.3`` to
+  ``h_far = 0.152 L`` at ``r = L`` (the ``medium`` rung's 0.303 for ``L = 2``).
+
+So for the paper sphere at ``beta = 200`` and ``level = 1`` the field is the
+``medium`` rung's, and ``level = 1/1.45`` divides every size by 1.45 like one
+ladder rung (about twice the elements).
+
+Edge-band width
+---------------
+``W(beta) = max(0.05, 1.17 beta^(-1/3))``: 0.2 at ``beta = 200`` (the
+ladder's annulus half-width, tuned on the paper sphere).  The band must hold
+the exit zone: the film's exit minimum sits past the Hertz edge and the film
+then opens.  Measured on the paper sphere (``benchmarks/fitted_mesh.md``,
+fine ladder mesh, ``t = 3``, centreline): the distance ``e`` from the Hertz
+edge to where the film past its exit minimum has doubled is 0.366, 0.165,
+0.083 at ``beta = 20, 200, 2000``, i.e. ``e ~ beta^(-0.32)``; ``W`` is 1.1-1.2
+times ``e`` at all three.  (A Hertzian boundary-layer argument, gap opening
+like ``(x/ell)^(3/2)`` and films ``h ~ beta^(-0.6)``, predicts ``beta^(-0.4)``
+for the constriction itself; the measured zone, which includes the opening,
+shrinks more slowly.)  The floor 0.05 keeps the band resolvable on a mesh for
+``beta >~ 10^4``.
+
+Accuracy (``benchmarks/fitted_mesh.md``): on the shipped ellipsoid (both
+orientations) a fitted mesh with the element count of the ``medium`` rung
+(``level = 1.45``) is within 1 % of the extrapolated minimum film at
+``t = 3``, where the ``medium`` rung is 11-13 % low (``xfine``, four times the
+elements: about 2 %); on the paper sphere the fitted ``level = 1`` mesh is the
+``medium`` rung's field (both within 1 %).  At ``beta = 2000`` the narrower
+band makes the fitted mesh at the medium count 3.7 % low (``medium``: 8.7 %,
+``fine``: 6.2 %); ``level = 1`` (the fine count) is within 1 %.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import pathlib
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from femehl.errors import MeshError, SceneError
+from femehl.fe.mesh import (
+    MAX_GMSH_ELEMENTS,
+    DiskMesh,
+    _write_msh,
+    check_mesh_memory,
+    load_mesh,
+    sized_disk,
+)
+
+__all__ = [
+    "CACHE_DIR",
+    "FittedSizes",
+    "contact_extent",
+    "fitted_disk",
+    "fitted_sizes",
+]
+
+#: Bump when the size field or the mesher changes: it is part of the cache key.
+FITTED_VERSION = 1
+#: Default mesh cache folder (``cache_dir=`` of :func:`fitted_disk` overrides it).
+CACHE_DIR = pathlib.Path("~/.cache/femehl/meshes")
+
+#: h_contact / a_min at level 1 (the medium rung's 0.138 / 1.45 for the unit sphere).
+C_CONTACT = 0.095
+#: h_edge / w: about ten elements across the band 2 w (medium rung: 0.0407 / 0.2).
+C_EDGE = 0.2035
+#: Band half-width / ell = max(W_MIN, C_WIDTH * beta**WIDTH_EXPONENT).
+C_WIDTH = 1.17
+WIDTH_EXPONENT = -1.0 / 3.0
+W_MIN = 0.05
+#: Width (in units of ell) over which h goes from h_edge to h_contact (ladder: 0.15).
+TRANSITION = 0.15
+#: The contact zone (size h_contact) is rho <= RHO_CONTACT (ladder: r_contact = 1.3).
+RHO_CONTACT = 1.3
+#: h_far / L (medium rung: 0.303 for L = 2).
+C_FAR = 0.152
+#: Smallest contact semi-axis used for sizes, in units of L (a scene with no
+#: indentation still gets its tip region resolved).
+A_FLOOR = 0.05
+
+# polar sampling of the gap: rays, radial samples, Gauss points of the Sneddon integrals
+_NTH, _NR, _NPHI = 96, 801, 48
+
+
+# ---------------------------------------------------------------------------
+# contact extent
+
+
+def _run_times(f, t_end: float) -> np.ndarray:
+    """Times in [0, t_end] at which a history is sampled: a fine grid plus its knots."""
+    extra = [float(t) for t in (getattr(f, "times", ()) or ())]
+    t1 = getattr(f, "t1", None)
+    if isinstance(t1, (int, float)):
+        extra.append(float(t1))
+    extra = [t for t in extra if math.isfinite(t) and 0.0 <= t <= t_end]
+    return np.unique(np.concatenate([np.linspace(0.0, t_end, 2001), extra]))
+
+
+def _polar_gap(scene):
+    """The gap on a full polar grid: ``th (nth,)``, ``r (nr,)``, ``S (nth, nr)`` (inf where undefined)."""
+    L = scene.domain.L
+    rmax = min(1.5 * L, max(float(getattr(scene.indenter, "extent", math.inf)), L))
+    th = np.linspace(0.0, 2.0 * math.pi, _NTH, endpoint=False)
+    r = np.linspace(0.0, rmax, _NR)
+    TH, RR = np.meshgrid(th, r, indexing="ij")
+    try:
+        with np.errstate(all="ignore"):
+            S = np.asarray(scene.indenter.gap(RR * np.cos(TH), RR * np.sin(TH)), dtype=float)
+    except Exception as exc:  # noqa: BLE001 - the user's shape: name the failure
+        raise SceneError(
+            f"contact_extent: the indenter's gap(x, y) failed on r <= {rmax:g} "
+            f"({type(exc).__name__}: {exc}); fix the shape function"
+        ) from None
+    S = np.where(np.isfinite(S), S, np.inf)
+    return th, r, S
+
+
+def _overlap_radius(r, S, depth) -> np.ndarray:
+    """Per ray, the largest radius where ``s < depth`` (linear between samples; 0 if none)."""
+    g = S - depth
+    neg = g < 0.0
+    out = np.zeros(S.shape[0])
+    rows = np.flatnonzero(neg.any(axis=1))
+    if rows.size == 0:
+        return out
+    last = S.shape[1] - 1 - np.argmax(neg[rows, ::-1], axis=1)
+    if np.any(last == S.shape[1] - 1):
+        raise SceneError(
+            f"contact_extent: an indentation {depth:.3g} deep overlaps the indenter beyond the "
+            f"sampled radius {r[-1]:.3g}; use a larger domain radius L"
+        )
+    g0, g1 = g[rows, last], g[rows, last + 1]
+    with np.errstate(all="ignore"):
+        frac = np.where(np.isfinite(g1), g0 / (g0 - g1), 1.0)
+    out[rows] = r[last] + frac * (r[last + 1] - r[last])
+    return out
+
+
+def _axes_of(th, radius) -> tuple[float, float]:
+    return float(np.max(np.abs(radius * np.cos(th)))), float(np.max(np.abs(radius * np.sin(th))))
+
+
+class _RaySneddon:
+    """Sneddon's axisymmetric contact, applied ray by ray to the profile ``f(r) = s(r, theta)``.
+
+    For an axisymmetric profile on a half space the contact radius ``c`` at depth
+    ``delta`` solves ``delta = c int_0^{pi/2} f'(c sin phi) dphi`` and the load is
+    ``F = (2 / (pi cc)) c^2 int_0^{pi/2} sin^2 phi f'(c sin phi) dphi`` in femehl's
+    units (``cc = 2 (1 - nu)``; for the unit sphere ``c = sqrt(delta)``,
+    ``F = 4 c^3 / (3 pi cc)``, design.md section 2).  Exact for every axisymmetric
+    indenter (Sphere, FlatPunch); for other shapes each ray is treated as if the
+    indenter were the body of revolution of that ray's profile (a heuristic: the
+    contact of an elliptic paraboloid is less eccentric than this gives).
+    """
+
+    def __init__(self, r, S, cc):
+        self.r, self.cc = r, cc
+        fp = np.gradient(np.where(np.isfinite(S), S, np.nan), r, axis=1)
+        self.fp = np.nan_to_num(fp, nan=0.0, posinf=0.0, neginf=0.0)
+        x, w = np.polynomial.legendre.leggauss(_NPHI)
+        self.phi = 0.25 * math.pi * (x + 1.0)
+        self.w = 0.25 * math.pi * w
+        dr = r[1] - r[0]
+        idx = r[:, None] * np.sin(self.phi)[None, :] / dr  # (nc, nphi) fractional indices
+        i0 = np.minimum(idx.astype(int), r.size - 2)
+        f = idx - i0
+        vals = self.fp[:, i0] * (1.0 - f) + self.fp[:, i0 + 1] * f  # (nth, nc, nphi)
+        self.depth = r[None, :] * (vals @ self.w)  # delta(c) per ray
+        self.load = (2.0 / (math.pi * cc)) * r[None, :] ** 2 * (vals @ (self.w * np.sin(self.phi) ** 2))
+
+    def radius(self, delta) -> np.ndarray:
+        """Per ray, the first contact radius ``c`` with ``delta(c) >= delta``."""
+        D = self.depth
+        hit = D >= delta
+        if not hit.any(axis=1).all():
+            raise SceneError(
+                f"contact_extent: an indentation {delta:.3g} deep spreads the contact beyond the "
+                f"sampled radius {self.r[-1]:.3g}; use a larger domain radius L"
+            )
+        k = np.argmax(hit, axis=1)
+        k0 = np.maximum(k - 1, 0)
+        rows = np.arange(D.shape[0])
+        d0, d1 = D[rows, k0], D[rows, k]
+        with np.errstate(all="ignore"):
+            frac = np.where(d1 > d0, (delta - d0) / (d1 - d0), 1.0)
+        return self.r[k0] + np.clip(frac, 0.0, 1.0) * (self.r[k] - self.r[k0])
+
+    def force(self, delta) -> float:
+        """Ray-averaged Sneddon load at depth ``delta``."""
+        c = self.radius(delta)
+        F = [np.interp(ci, self.r, row) for ci, row in zip(c, self.load, strict=True)]
+        return float(np.mean(F))
+
+
+def hertz_ellipse(Rx: float, Ry: float, delta: float) -> tuple[float, float, float]:
+    """Hertz contact of the elliptic paraboloid ``x^2/(2 Rx) + y^2/(2 Ry)`` pressed ``delta`` deep.
+
+    Returns ``(ax, ay, m)``: the semi-axes along x and y and ``m = e^2 = 1 -
+    (short/long)^2``.  With curvatures ``A <= B`` (``A`` along the long axis),
+    ``B/A = (E(m)/(1 - m) - K(m)) / (K(m) - E(m))`` fixes ``m`` and
+    ``a_long^2 = delta (K - E) / (A K m)`` (Johnson, Contact Mechanics, section 3.5,
+    with ``delta = cc pi b p0 K`` in femehl's units); a sphere (``m -> 0``) gives
+    ``a = sqrt(R delta)``.  Independent of the substrate's compliance.
+    """
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipk
+
+    A, B = 1.0 / (2.0 * Rx), 1.0 / (2.0 * Ry)
+    lo, hi = min(A, B), max(A, B)
+    q = hi / lo
+    if q < 1.0 + 1e-9:
+        a = math.sqrt(delta / (2.0 * lo))
+        return a, a, 0.0
+
+    def f(m):
+        K, E = ellipk(m), ellipe(m)
+        return (E / (1.0 - m) - K) / (K - E) - q
+
+    m = brentq(f, 1e-12, 1.0 - 1e-15, xtol=1e-15)
+    K, E = ellipk(m), ellipe(m)
+    a = math.sqrt(delta * (K - E) / (lo * K * m))
+    b = a * math.sqrt(1.0 - m)
+    return ((a, b) if A < B else (b, a)) + (float(m),)
+
+
+def _hertz_ellipse_load(Rx, Ry, delta, cc) -> float:
+    """Hertz load ``F = (2/3) a_long delta / (cc K(m))`` (unit sphere: ``4 delta^(3/2) / (3 pi cc)``)."""
+    from scipy.special import ellipk
+
+    ax, ay = hertz_ellipse(Rx, Ry, delta)[:2]
+    along = max(ax, ay)
+    m = 1.0 - (min(ax, ay) / along) ** 2
+    return (2.0 / 3.0) * along * delta / (cc * float(ellipk(m)))
+
+
+def _invert(F_of, F, what) -> float:
+    """Depth ``delta`` with ``F_of(delta) = F`` (monotone), by doubling then bisection."""
+    lo, hi = 0.0, 1e-3
+    while F_of(hi) < F:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1e6:
+            raise SceneError(f"contact_extent: {what} cannot carry the load {F:g}; check the load history")
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if F_of(mid) < F else (lo, mid)
+    return hi
+
+
+def contact_extent(scene, t_end: float) -> tuple[float, float]:
+    """The largest dry-contact semi-axes ``(ax, ay)`` along x and y over a run to ``t_end``.
+
+    The deepest indentation of the run is ``delta = -min hc(t)`` (imposed gap;
+    ``t`` sampled on 2001 points of ``[0, t_end]`` plus the history's knots), or
+    under an imposed load the depth at which the *dry* contact carries the
+    largest ``F(t)`` (the film only adds a thin layer).  The contact at that depth:
+
+    * half space, a paraboloid (an indenter with ``curvature_radii()``: Sphere,
+      Ellipsoid): Hertz (:func:`hertz_ellipse`; sphere ``a = sqrt(R delta)``,
+      ``F = 4 a^3/(3 pi cc)``);
+    * half space, any other shape: Sneddon's axisymmetric solution ray by ray
+      (:class:`_RaySneddon`; exact for FlatPunch; a heuristic for a shape
+      without axial symmetry), load the ray average;
+    * Winkler or rigid: the geometric overlap ``hc + s < 0`` (a Winkler
+      foundation has no lateral spreading); Winkler load ``F = k int (delta - s)+ dA``;
+      a rigid substrate is never indented under load: ``(0, 0)``.
+
+    The shape is sampled on a polar grid (96 rays, 801 radii out to
+    ``min(1.5 L, map extent)``) as ``Scene._check_domain_holds_contact`` does.
+
+    Returns
+    -------
+    (float, float)
+        ``(0.0, 0.0)`` if the indenter never touches (``hc >= 0`` throughout or
+        zero load).
+
+    Raises
+    ------
+    SceneError
+        If ``t_end`` is not positive, or the contact spreads beyond the sampled disk.
+    """
+    if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
+        raise SceneError(f"contact_extent: t_end = {t_end!r} must be a positive finite time")
+    motion, sub, ind = scene.motion, scene.substrate, scene.indenter
+    kind = getattr(sub, "kind", "halfspace")
+    cc = float(getattr(sub, "compliance", 1.0))
+    radii = getattr(ind, "curvature_radii", None)  # a paraboloid: Sphere, Ellipsoid
+    th, r, S = _polar_gap(scene)
+    if kind == "halfspace" and callable(radii):
+        Rx, Ry = (float(v) for v in radii())
+
+        def axes(delta):
+            return hertz_ellipse(Rx, Ry, delta)[:2]
+
+        def F_of(delta):
+            return _hertz_ellipse_load(Rx, Ry, delta, cc)
+    elif kind == "halfspace":
+        rs = _RaySneddon(r, S, cc)
+
+        def axes(delta):
+            return _axes_of(th, rs.radius(delta))
+
+        F_of = rs.force
+    else:
+
+        def axes(delta):
+            return _axes_of(th, _overlap_radius(r, S, delta))
+
+        k = float(getattr(sub, "k", 0.0))
+        area = (r[1] - r[0]) * r * (2.0 * math.pi / th.size)  # dA of a sample on each ray
+
+        def F_of(delta):
+            return k * float(np.sum(np.maximum(delta - S, 0.0) @ area))
+
+    if motion.load_controlled:
+        F = max(motion.F(float(t)) for t in _run_times(motion.load, t_end))
+        if F <= 0.0 or kind == "rigid":
+            return 0.0, 0.0
+        delta = _invert(F_of, F, f"the {kind} substrate")
+    else:
+        delta = -min(motion.hc(float(t)) for t in _run_times(motion.gap, t_end))
+        if delta <= 0.0:
+            return 0.0, 0.0
+    ax, ay = axes(delta)
+    return float(ax), float(ay)
+
+
+# ---------------------------------------------------------------------------
+# size field
+
+
+@dataclass(frozen=True)
+class FittedSizes:
+    """The size field of a fitted mesh (see the module docstring).
+
+    Attributes
+    ----------
+    ax, ay : float
+        Contact semi-axes used (``contact_extent``, floored at ``A_FLOOR * L``).
+    h_contact : float
+        Size in the contact zone ``rho <= RHO_CONTACT``.
+    edge_coef : float
+        Edge size / ``ell`` (``h_edge = edge_coef * ell``).
+    width : float
+        Edge-band half-width / ``ell``.
+    h_far : float
+        Size at ``r = L``.
+    L : float
+        Disk radius.
+    beta : float
+        The scene's beta (sets ``width``).
+    level : float
+        The factor all sizes were multiplied by.
+    """
+
+    ax: float
+    ay: float
+    h_contact: float
+    edge_coef: float
+    width: float
+    h_far: float
+    L: float
+    beta: float
+    level: float
+
+    def size(self, x: float, y: float) -> float:
+        """The mesh size at ``(x, y)`` (scalar, pure Python: gmsh calls it per point)."""
+        ax, ay, L = self.ax, self.ay, self.L
+        u, v = x / ax, y / ay
+        rho = math.sqrt(u * u + v * v)
+        g = math.hypot(u / ax, v / ay)
+        ell = rho / g if g > 0.0 else min(ax, ay)
+        h_c = self.h_contact
+        h_e = self.edge_coef * ell
+        dn = abs(rho - 1.0) * ell
+        band = h_e + (h_c - h_e) * max(dn - self.width * ell, 0.0) / (TRANSITION * ell)
+        if rho <= RHO_CONTACT:
+            zone = h_c
+        else:
+            r = math.hypot(x, y)
+            rc = RHO_CONTACT * r / rho
+            frac = min((r - rc) / (L - rc), 1.0) if rc < L else 0.0
+            zone = h_c + (self.h_far - h_c) * frac
+        return min(band, zone)
+
+    def estimate_elements(self, half: bool) -> float:
+        """About how many triangles gmsh makes: ``int 4 / (sqrt(3) h^2) dA`` (polar midpoint rule)."""
+        nr, nt = 500, 240
+        r = (np.arange(nr) + 0.5) * self.L / nr
+        span = math.pi if half else 2.0 * math.pi
+        th = (np.arange(nt) + 0.5) * span / nt
+        tot = 0.0
+        for t in th:
+            c, s = math.cos(t), math.sin(t)
+            tot += sum(ri / self.size(ri * c, ri * s) ** 2 for ri in r)
+        return tot * (self.L / nr) * (span / nt) * 4.0 / math.sqrt(3.0)
+
+    def key(self, half: bool) -> dict:
+        """Everything the mesh depends on (the cache key)."""
+        import gmsh
+
+        d = {k: float(f"{v:.12g}") for k, v in asdict(self).items() if k not in ("beta", "level")}
+        d.update(
+            half=bool(half),
+            gmsh=gmsh.__version__,
+            version=FITTED_VERSION,
+            consts=[C_CONTACT, C_EDGE, TRANSITION, RHO_CONTACT],
+        )
+        return d
+
+
+def _check_level(level) -> float:
+    if not (isinstance(level, (int, float, np.number)) and math.isfinite(level) and level > 0):
+        raise MeshError(
+            f"fitted mesh: level = {level!r} must be a positive finite number (1: default sizes, "
+            "1/1.45: about twice the elements)"
+        )
+    return float(level)
+
+
+def fitted_sizes(scene, t_end: float, level: float = 1.0) -> FittedSizes:
+    """The size field fitted to ``scene`` over a run to ``t_end`` (every size times ``level``)."""
+    level = _check_level(level)
+    L = float(scene.domain.L)
+    ax, ay = contact_extent(scene, t_end)
+    floor = A_FLOOR * L
+    ax, ay = max(ax, floor), max(ay, floor)
+    beta = float(scene.fluid.beta)
+    width = max(W_MIN, C_WIDTH * beta**WIDTH_EXPONENT)
+    return FittedSizes(
+        ax=ax,
+        ay=ay,
+        h_contact=C_CONTACT * min(ax, ay) * level,
+        edge_coef=C_EDGE * width * level,
+        width=width,
+        h_far=min(C_FAR * L * level, L),
+        L=L,
+        beta=beta,
+        level=level,
+    )
+
+
+# ---------------------------------------------------------------------------
+# mesh and cache
+
+
+def _cache_path(sizes: FittedSizes, half: bool, cache_dir) -> pathlib.Path:
+    key = json.dumps(sizes.key(half), sort_keys=True).encode()
+    tag = hashlib.sha256(key).hexdigest()[:16]
+    folder = pathlib.Path(CACHE_DIR if cache_dir is None else cache_dir).expanduser()
+    return folder / f"fitted_{'half' if half else 'full'}-{tag}.msh"
+
+
+def _renamed(dm: DiskMesh, name: str) -> DiskMesh:
+    return DiskMesh(dm.mesh, dm.L, dm.half, name)
+
+
+def fitted_disk(
+    scene, t_end: float, level: float = 1.0, half: bool | None = None, *, cache: bool = True, cache_dir=None
+) -> DiskMesh:
+    """A gmsh mesh of the scene's disk refined at the contact of a run to ``t_end``.
+
+    Parameters
+    ----------
+    scene : femehl.Scene
+        The scene (indenter, substrate, motion, fluid beta, domain radius L).
+    t_end : float
+        End time of the run (the contact is the largest one in ``[0, t_end]``).
+    level : float, default 1.0
+        Multiplies every mesh size; ``1/1.45`` gives about twice the elements
+        (one ladder rung), for convergence studies.
+    half : bool or None, default None
+        Half disk ``y >= 0``; None: the indenter's ``symmetric_y``.
+    cache : bool, default True
+        Look the mesh up in, and store it to, the cache folder.
+    cache_dir : path, optional
+        Cache folder, default :data:`CACHE_DIR` (``~/.cache/femehl/meshes``).
+        The file name is a hash of the sizes, contact axes, L, half, the gmsh
+        version and :data:`FITTED_VERSION`: a second call is a load.
+
+    Returns
+    -------
+    DiskMesh
+        Checked as by :func:`~femehl.fe.mesh.load_mesh`; ``name`` is
+        ``"fitted-<hash>"``.  Pass it as ``femehl.solve(scene, mesh=dm, ...)``.
+
+    Raises
+    ------
+    MeshError
+        For a bad ``level``, a half disk for an indenter not symmetric in y, or
+        sizes that would make more than ``MAX_GMSH_ELEMENTS`` elements.
+    """
+    sym = bool(getattr(scene.indenter, "symmetric_y", False))
+    half = sym if half is None else bool(half)
+    if half and not sym:
+        raise MeshError(
+            "fitted_disk: half=True needs an indenter symmetric in y (symmetric_y); pass "
+            "half=False (or None) for the full disk"
+        )
+    sizes = fitted_sizes(scene, t_end, level)
+    path = _cache_path(sizes, half, cache_dir)
+    name = f"fitted-{path.stem.split('-')[-1]}"
+    if cache and path.is_file():
+        try:
+            return _renamed(load_mesh(path, L=sizes.L, half=half), name)
+        except MeshError:
+            pass  # a damaged cache file: regenerate it below
+    ne = sizes.estimate_elements(half)
+    if not ne <= MAX_GMSH_ELEMENTS:
+        raise MeshError(
+            f"fitted_disk: level = {sizes.level:g} would make about {ne:.3g} elements, more than "
+            f"{MAX_GMSH_ELEMENTS:.0e}; pass a larger level"
+        )
+    check_mesh_memory(int(ne), int(ne / 2), f"fitted_disk(level={sizes.level:g}) (estimated)")
+    dm = sized_disk(sizes.L, half, sizes.size, name)
+    if cache:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            _write_msh(dm, path)
+        except OSError:
+            pass  # an unwritable cache only costs the next call a remesh
+    return dm

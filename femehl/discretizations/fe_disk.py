@@ -23,12 +23,22 @@ import scipy.sparse as sp
 from skfem import Basis, ElementTriP0, ElementTriP1
 
 from ..errors import SceneError
+from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
 from ..kernels import edge_terms, mesh_edges, triangle_influence
 from . import register_method
 from ._p1p0 import P1P0
 
 __all__ = ["FEDisc"]
+
+
+#: the mesh name that asks for a mesh fitted to the scene (:func:`femehl.fe.fitted.fitted_disk`)
+FITTED = "fitted"
+
+
+def _horizon(scene) -> float:
+    """The span a fitted mesh covers when the run's end is not known: every breakpoint, >= 10."""
+    return max([10.0, *scene.motion.breakpoints])
 
 
 def _looks_like_path(s: str) -> bool:
@@ -43,7 +53,9 @@ class FEDisc(P1P0):
     ----------
     scene : femehl.Scene
     mesh : str, path, skfem.MeshTri or DiskMesh, default: "medium"
-        A ladder name ("coarse", "medium", "fine", "xfine") or any mesh meshio reads.
+        A ladder name ("coarse", "medium", "fine", "xfine"), ``"fitted"`` (a gmsh mesh
+        refined at this scene's contact, :func:`femehl.fe.fitted.fitted_disk`, cached), or
+        any mesh meshio reads.
     half : bool, optional
         Use the half disk y >= 0; default: True when the indenter is symmetric in y.
     """
@@ -59,11 +71,15 @@ class FEDisc(P1P0):
             raise SceneError(f"half must be True, False or None (automatic), got {half!r}.")
         if half is None:
             half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
+            half = symmetric if mesh == FITTED else half
         if half and not symmetric:
             raise SceneError(
                 "a half-disk mesh needs an indenter symmetric in y; use half=False or a full-disk mesh."
             )
-        dm = load_mesh(mesh, L=scene.domain.L, half=half)
+        if isinstance(mesh, str) and mesh == FITTED:
+            dm = fitted_disk(scene, _horizon(scene), half=half)
+        else:
+            dm = load_mesh(mesh, L=scene.domain.L, half=half)
         if dm.half and not symmetric:
             raise SceneError(
                 f"mesh {dm.name!r} is a half disk but the indenter is not symmetric "

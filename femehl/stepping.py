@@ -148,14 +148,13 @@ def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None)
 def film_floor(state: State) -> tuple:
     """``(d, (x, y), where)``: the thinnest (or a non-finite) film ``state`` knows of.
 
-    Candidates: the film points, the origin (the central film) and the probed nodes.
+    Candidates: the origin (the central film), the probed nodes and the film points; on a
+    tie the first named wins (``state.film_min`` is already the smallest of them all).
     """
-    cands = [
-        (state.film_min, tuple(state.film_min_at), "the film points"),
-        (state.film_center, (0.0, 0.0), "the origin"),
-    ]
+    cands = [(state.film_center, (0.0, 0.0), "the origin")]
     if "node_film_min" in state.info:
         cands.append((state.info["node_film_min"], tuple(state.info["node_film_min_at"]), "a node"))
+    cands.append((state.film_min, tuple(state.film_min_at), "the film points"))
     bad = [c for c in cands if not math.isfinite(c[0])]
     return bad[0] if bad else min(cands, key=lambda c: c[0])
 

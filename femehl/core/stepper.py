@@ -15,9 +15,11 @@ right-hand side is affine in hc (``h = hc + s``), so with ``A x1 = b(h = s)`` an
 ``hc = (g . x1 - F) / (g . x2)`` and ``p = x1 - hc x2``: one operator, two right-hand
 sides, still one linear system per step.  This is the only place it is written.
 
-After the solve the film is checked everywhere the discretization can tell: on its film
+After the solve the film is known everywhere the discretization can tell: on its film
 points, at the origin (exact compliance row) and at the nodes where a cheap estimate of
-the nodal film is thin (exact compliance rows there).  A film <= 0 anywhere raises
+the nodal film is thinnest (exact compliance rows there).  ``State.film_min`` is the
+smallest of them (so the central film is never below it; ``info["film_points_min"]`` is
+the film points' own minimum), and a film <= 0 anywhere raises
 :class:`~femehl.errors.FilmRuptureError` from :func:`femehl.stepping.march`.
 """
 
@@ -37,6 +39,8 @@ __all__ = ["LaggedStepper"]
 
 _PROBE_FRACTION = 0.5  # nodes whose estimated film is below this x the film minimum are checked exactly
 _MAX_PROBES = 64
+_ALWAYS_PROBED = 8  # the nodes of smallest estimated film, checked exactly at every step
+_ROW_CACHE = 512  # compliance rows of probed nodes kept between steps
 
 
 def _nbytes(a) -> int:
@@ -98,6 +102,7 @@ class LaggedStepper:
         self.shape = disc.shape
         self.g = disc.load_weights
         self._FC: dict[str, object] = {}
+        self._rows_cache: dict[int, np.ndarray] = {}
         self.info = dict(disc.info)
         self.info.update(
             {
@@ -159,6 +164,17 @@ class LaggedStepper:
         i_max = int(np.argmax(p_full))
         info = dict(info or {})
         info.update(self._probe(hc, p, Cp, float(d[i_min])))
+        film_center = hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0])
+        # the reported minimum is the true minimum of the discrete film: film points, the
+        # origin and the probed nodes (the central film is never below it)
+        info["film_points_min"] = float(d[i_min])
+        lows = [
+            (float(d[i_min]), tuple(float(v) for v in disc.film_points[i_min])),
+            (film_center, (0.0, 0.0)),
+        ]
+        if "node_film_min" in info:
+            lows.append((info["node_film_min"], info["node_film_min_at"]))
+        film_min, film_min_at = min(lows, key=lambda c: c[0] if np.isfinite(c[0]) else -np.inf)
         return State(
             step=step,
             t=t,
@@ -168,9 +184,9 @@ class LaggedStepper:
             w=w,
             d=d,
             load=float(self.g @ p),
-            film_center=hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0]),
-            film_min=float(d[i_min]),
-            film_min_at=tuple(float(v) for v in disc.film_points[i_min]),
+            film_center=film_center,
+            film_min=film_min,
+            film_min_at=film_min_at,
             p_max=float(p_full[i_max]),
             p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
             info=info,
@@ -179,20 +195,42 @@ class LaggedStepper:
         )
 
     def _probe(self, hc, p, Cp, d_min):
-        """The film at the nodes whose estimated film is thin, computed exactly."""
+        """The exact film at the nodes where a cheap nodal estimate says it is thinnest.
+
+        The estimate is ``hc + s(node) +`` the mean of ``C p`` over the elements around the
+        node; the ``_ALWAYS_PROBED`` smallest, and every node below ``_PROBE_FRACTION``
+        times the film-point minimum (at most ``_MAX_PROBES``), get the exact value from
+        the substrate's rows at the node (kept between steps: the thin nodes move slowly).
+        """
         avg = self.disc.node_average
         if avg is None:
             return {}
         est = hc + self.disc.node_shape + avg @ Cp
+        k = min(_ALWAYS_PROBED, est.size)
+        near = np.argpartition(est, k - 1)[:k]
         thin = np.flatnonzero(est < _PROBE_FRACTION * d_min)
-        if thin.size == 0:
-            return {}
         thin = thin[np.argsort(est[thin])[:_MAX_PROBES]]
-        pts = self.disc.nodes[thin]
-        rows = self.scene.substrate.deflection_rows(self.disc, pts)
-        exact = hc + self.disc.node_shape[thin] + np.asarray(rows @ p).ravel()
+        nodes = np.union1d(near, thin)
+        rows = self._node_rows(nodes)
+        exact = hc + self.disc.node_shape[nodes] + rows @ p
         j = int(np.argmin(exact))
-        return {"node_film_min": float(exact[j]), "node_film_min_at": tuple(float(v) for v in pts[j])}
+        return {
+            "node_film_min": float(exact[j]),
+            "node_film_min_at": tuple(float(v) for v in self.disc.nodes[nodes[j]]),
+        }
+
+    def _node_rows(self, nodes):
+        """Dense compliance rows at the given node indices, from a bounded cache."""
+        cache = self._rows_cache
+        new = [i for i in nodes if i not in cache]
+        if new:
+            R = self.scene.substrate.deflection_rows(self.disc, self.disc.nodes[new])
+            R = R.toarray() if sp.issparse(R) else np.asarray(R)
+            for i, r in zip(new, R, strict=True):
+                cache[i] = r
+            while len(cache) > _ROW_CACHE:
+                cache.pop(next(iter(cache)))
+        return np.array([cache[i] for i in nodes])
 
     def initial_state(self) -> State:
         mo = self.scene.motion

@@ -48,6 +48,12 @@ def _parser():
     r.add_argument("--n-elements", type=int, help="line contact: number of elements (default 400)")
     r.add_argument("--dt", type=float, help="time step (default 0.01)")
     r.add_argument(
+        "--tol",
+        type=float,
+        help="adaptive time steps to this relative error per unit time (e.g. 0.01); "
+        "--dt is then the first step",
+    )
+    r.add_argument(
         "--scheme",
         choices=["euler", "bdf2"],
         help="FE time scheme: euler (the paper's, default) or bdf2 (second order)",
@@ -71,7 +77,7 @@ def _parser():
 
 
 FD_KEYS = ("dr", "dtheta")
-RUN_KEYS = ("dt", "t_end", "store_every", "checkpoint_every")
+RUN_KEYS = ("dt", "t_end", "store_every", "checkpoint_every", "tol")
 
 
 def _method_options(run: dict, method: str, from_cli: bool) -> dict:
@@ -133,7 +139,7 @@ def _run(args, argv=()):
         )
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
-    for key in ("scheme", "mesh", "n_elements", "dt", "t_end", "store_every"):
+    for key in ("scheme", "mesh", "n_elements", "dt", "tol", "t_end", "store_every"):
         v = getattr(args, key)
         if v is not None and not (key == "scheme" and method == "fd"):  # fd: euler, its own scheme
             run[key] = v
@@ -155,7 +161,7 @@ def _run(args, argv=()):
             out,
             method=method,
             t_end=run.pop("t_end", 5.0),
-            dt=run.pop("dt", 0.01),
+            dt=run.pop("dt", None),
             store_every=run.pop("store_every", 10),
             progress=not args.quiet,
             resume=resume,
@@ -174,7 +180,7 @@ def _run(args, argv=()):
     if dim is not None:
         print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
     for t in sorted({1.0, float(res.t[-1])}):
-        if t <= res.t[-1] + 1e-9:
+        if res.t[0] - 1e-9 <= t <= res.t[-1] + 1e-9:  # a resumed run starts at its checkpoint
             print(
                 f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
                 f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}"

@@ -25,7 +25,7 @@ import time
 from .api import make_stepper, run_loop
 from .errors import OutputError, SceneError, SolverError
 from .output import RunWriter, checkpoint, draw_figures
-from .output._validation import check_flag, check_resume_overwrite, check_run_options
+from .output._validation import check_flag, check_resume_overwrite, check_run_options, check_tol
 from .output.folder import check_folder, prepare_folder
 from .result import Result
 
@@ -49,8 +49,8 @@ def _reporter(log):
 
 def _check_resume_time(start, t_end: float, dt: float) -> None:
     """The checkpoint's time is on the run's time grid and not past ``t_end``."""
-    k = round(start.t / dt)
-    if abs(k * dt - start.t) > 1e-9 * max(1.0, start.t):
+    k = round(start.t / dt) if dt is not None else 0
+    if dt is not None and abs(k * dt - start.t) > 1e-9 * max(1.0, start.t):
         raise SceneError(
             f"cannot resume at t = {start.t:g} with dt = {dt:g}: resume with the dt of the original run."
         )
@@ -90,13 +90,14 @@ def run_to_folder(
     *,
     method=None,
     t_end=5.0,
-    dt=0.01,
+    dt=None,
     store_every=10,
     progress=False,
     log=None,
     checkpoint_every=None,
     resume=False,
     overwrite=False,
+    tol=None,
     **options,
 ) -> Result:
     """Solve ``scene`` and write ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs.
@@ -106,7 +107,9 @@ def run_to_folder(
     scene : femehl.Scene
     folder : path-like
     method : str, default: "fe"
-    t_end, dt : float, default: 5.0, 0.01
+    t_end : float, default: 5.0
+    dt : float, optional
+        Time step (default 0.01); with ``tol`` the first step (default: the controller's).
     store_every : int, default: 10
         Fields are kept and written every ``store_every`` steps (and at the end).
     progress : bool, default: False
@@ -124,6 +127,10 @@ def run_to_folder(
     overwrite : bool, default: False
         Replace a run already in ``folder`` (its femehl files are removed first; other
         files are left alone).  Without it such a folder is refused with OutputError.
+    tol : float, optional
+        Adaptive time steps to this relative error per unit time
+        (:mod:`femehl.core.adaptive`); ``dt`` is then the first step and the scheme BDF2
+        unless given.  ``store_every`` and ``checkpoint_every`` count accepted steps.
     **options
         Discretization options of the method (``mesh``, ``dr``, ``dtheta``, ...).
 
@@ -134,19 +141,25 @@ def run_to_folder(
     SolverError, KeyboardInterrupt
         The run stopped: ``exc.result`` is the partial Result, the files stay readable.
     """
-    t_end, dt, nsteps, store_every, every = check_run_options(t_end, dt, store_every, checkpoint_every)
+    tol = check_tol(tol)
+    if tol is not None:
+        options.setdefault("scheme", "bdf2")
+    step = 0.01 if dt is None else dt  # fixed steps; with tol only checked (None: the controller's)
+    t_end, step, nsteps, store_every, every = check_run_options(t_end, step, store_every, checkpoint_every)
+    dt = step if tol is None or dt is not None else None
     resume, overwrite = check_resume_overwrite(resume, overwrite)
     progress = check_flag("progress", progress)
     say = _reporter(log)
     folder = check_folder(folder, resume=resume, overwrite=overwrite)
     t0 = time.perf_counter()
     stepper = make_stepper(scene, method, **options)
-    params = checkpoint.run_params(scene, stepper, dt)
+    params = checkpoint.run_params(scene, stepper, step)
+    params["tol"] = tol
     start = None
     if resume:
         checkpoint.check_params(checkpoint.read_params(folder), params)
         start = checkpoint.load_checkpoint(folder, reference=stepper.initial_state())
-        _check_resume_time(start, t_end, dt)
+        _check_resume_time(start, t_end, None if tol is not None else dt)
     say(_terms(scene, stepper, t_end) + f"; set-up {time.perf_counter() - t0:.1f} s")
 
     # ---- everything is checked: from here on the folder is written ----
@@ -168,8 +181,15 @@ def run_to_folder(
     if progress:
         from tqdm import tqdm
 
-        done = 0 if start is None else round(start.t / dt)
-        bar = tqdm(total=nsteps, initial=done, unit="step", desc=f"femehl {stepper.method}", leave=True)
+        done = 0 if start is None else round(start.t / step)
+        total = nsteps if tol is None else None  # adaptive: the number of steps is not known
+        bar = tqdm(
+            total=total,
+            initial=done if tol is None else 0,
+            unit="step",
+            desc=f"femehl {stepper.method}",
+            leave=True,
+        )
     last = {"state": None, "saved": None}
 
     def on_state(state):
@@ -194,7 +214,9 @@ def run_to_folder(
     result = None
     finished = False
     try:
-        result = run_loop(stepper, t_end, dt, start=start, store_every=store_every, on_state=on_state)
+        result = run_loop(
+            stepper, t_end, dt, tol=tol, start=start, store_every=store_every, on_state=on_state
+        )
         finished = True
     except SolverError as exc:
         result = getattr(exc, "result", None)

@@ -90,9 +90,10 @@ RUN_KEYS = {
     "dr",
     "dtheta_divisions",
     "linear_solver",
+    "tol",
 }
 #: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
-LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading"}
+LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading", "tol"}
 
 
 def _build(registry, table, where, path):

@@ -421,7 +421,7 @@ def march_adaptive(
             run.dt = min(run.dt, dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
     logger.info(
-        "adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
+        "femehl: adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
         t_end,
         run.accepted_total,
         run.rejected_total,

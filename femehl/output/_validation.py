@@ -51,6 +51,18 @@ def check_resume_overwrite(resume, overwrite) -> tuple[bool, bool]:
     return resume, overwrite
 
 
+def check_tol(tol):
+    """``tol`` as a float in (0, 0.5), or None (fixed time steps)."""
+    if tol is None:
+        return None
+    from ..validation import check_positive
+
+    tol = check_positive("tol", tol, "Give the relative error per unit time, e.g. tol = 1e-2.")
+    if tol >= 0.5:
+        raise SceneError(f"tol = {tol:g} is not a relative error: give 0 < tol < 0.5, e.g. 1e-2.")
+    return tol
+
+
 def check_run_options(t_end, dt, store_every, checkpoint_every):
     """``(t_end, dt, nsteps, store_every, checkpoint_every)`` of a run, checked.
 

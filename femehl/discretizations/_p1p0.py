@@ -62,3 +62,16 @@ class P1P0:
     def average(self):
         """The element average of the P1 pressure (elements x free nodes)."""
         return self.P[:, self.free]
+
+    # ---- fields for results (``pressure_rows`` and ``_cell_value`` are the mesh's) -----
+    def pressure_at(self, p, points):
+        """P1 interpolation of nodal ``p``; 0 outside the mesh (p = 0 beyond the rim)."""
+        return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()
+
+    def film_at(self, d, points):
+        """Element-constant film thickness at ``points`` (NaN beyond the domain)."""
+        return self._cell_value(d, points)
+
+    def deflection_at(self, w, points):
+        """Element-constant deflection at ``points`` (NaN beyond the domain)."""
+        return self._cell_value(w, points)

@@ -193,9 +193,6 @@ class FEDisc(P1P0):
         return np.hypot(pts[:, 0], pts[:, 1]) > self.L * (1.0 + 1e-9)
 
     # ---- fields for results and writers -----------------------------------------------
-    def pressure_at(self, p, points):
-        """P1 interpolation; 0 outside the mesh (p = 0 beyond r = L)."""
-        return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()
 
     def _cell_value(self, values, points):
         """Element values at points; a point of the disk between the polygonal rim and the
@@ -210,13 +207,6 @@ class FEDisc(P1P0):
 
             out[rim] = np.asarray(values)[cKDTree(self.centroids).query(pts[rim])[1]]
         return out
-
-    def film_at(self, d, points):
-        """Element-constant film thickness (NaN outside the mesh)."""
-        return self._cell_value(d, points)
-
-    def deflection_at(self, w, points):
-        return self._cell_value(w, points)
 
     def vtk_geometry(self):
         """Points (z = 0), triangles, and False: film fields live on elements."""

@@ -116,8 +116,6 @@ class LineDisc(P1P0):
         return np.abs(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0]) > self.L * (1.0 + 1e-9)
 
     # ---- fields for results and writers -----------------------------------------------
-    def pressure_at(self, p, points):
-        return np.asarray(self.pressure_rows(points) @ np.asarray(p, dtype=float)[self.free]).ravel()
 
     def _cell_value(self, values, points):
         xq = np.asarray(points, dtype=float).reshape(-1, 2)[:, 0]
@@ -126,12 +124,6 @@ class LineDisc(P1P0):
         e = np.clip(np.searchsorted(self.x, xq[ok]) - 1, 0, self.nelements - 1)
         out[ok] = np.asarray(values)[e]
         return out
-
-    def film_at(self, d, points):
-        return self._cell_value(d, points)
-
-    def deflection_at(self, w, points):
-        return self._cell_value(w, points)
 
     def vtk_geometry(self):
         """Points on y = z = 0, line cells, and False: film fields live on elements."""

@@ -71,7 +71,7 @@ def _parser():
         help="replace the run already in the output folder (its femehl files only)",
     )
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
-    b.add_argument("what", choices=["accuracy", "stress"], help="which study")
+    b.add_argument("what", choices=["accuracy", "stress", "fitted_mesh"], help="which study")
     b.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 

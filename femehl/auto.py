@@ -109,9 +109,13 @@ def _run(scene, t_end, level, tol_t, store_every, options) -> tuple[Result, list
     """One adaptive run on the fitted mesh at ``level``; also every step's (t, dt, err)."""
     mesh = fitted_disk(scene, t_end, level=level)
     steps = []
+    user = options.get("callback")
+    options = {k: v for k, v in options.items() if k != "callback"}
 
     def record(state):
         steps.append((state.t, state.info.get("dt", 0.0), state.info.get("error_estimate", np.nan)))
+        if user is not None:
+            user(state)
 
     t0 = time.perf_counter()
     res = solve(
@@ -144,7 +148,8 @@ def solve_to_tolerance(
     (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
     ``reached``, ``levels``, ``elements``, ``steps`` and ``wall`` of every run, and the
     largest estimated ``space``, ``time`` and ``total`` errors.  ``level`` is the first
-    (coarsest) level; ``options`` go to :func:`femehl.solve` (not ``mesh``, ``tol``).
+    (coarsest) level; ``options`` go to :func:`femehl.solve` (not ``mesh``, ``tol``);
+    a ``callback`` is called with the states of every run.
     """
     if method != "fe":
         raise SceneError(f"solve_to_tolerance: method {method!r} is not supported yet; use method='fe'.")

@@ -11,6 +11,7 @@ machine, so the reference is precomputed and the non-slow test starts one level 
 from __future__ import annotations
 
 import json
+import logging
 import pathlib
 
 import numpy as np
@@ -122,3 +123,14 @@ def test_default_levels_are_honest(name):
     res = solve_to_tolerance(_scenes()[name], t_end=T_END, tol=TOL, max_elements=13_000)
     assert res.info["auto"]["reached"]
     check_honest(res, _reference(name))
+
+
+def test_budget_stops_with_a_warning(caplog):
+    """A budget below the second level: one run, no estimate, reached False, a warning."""
+    scene = femehl.presets.paper_sphere()
+    with caplog.at_level(logging.WARNING, logger="femehl"):
+        res = solve_to_tolerance(scene, t_end=0.1, level=3.0, max_elements=100, store_every=0)
+    assert res.info["auto"]["reached"] is False and len(res.info["auto"]["levels"]) == 1
+    assert "not reached" in caplog.text
+    with pytest.raises(femehl.SceneError, match="solve_to_tolerance"):
+        res.uncertainty("load", 0.05)

@@ -41,6 +41,9 @@ class Result:
     _rows: dict = field(default_factory=lambda: {k: [] for k in _SCALARS + ("film_min_at", "p_max_at")})
     _stored: list = field(default_factory=list)
     info: dict = field(default_factory=dict)
+    #: error estimate of :func:`femehl.auto.solve_to_tolerance` (None otherwise):
+    #: ``{"t": times, name: {"space": ..., "time": ..., "total": ...}}``, relative errors
+    estimate: dict | None = None
 
     def record(self, state: State, store_fields: bool = True) -> None:
         """Append one state's scalars (and its fields when ``store_fields``)."""
@@ -180,6 +183,27 @@ class Result:
                 f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}]: give a time the run reached."
             )
         return float(np.interp(t, ts, getattr(self, name)))
+
+    def uncertainty(self, name: str, t: float) -> dict:
+        """Estimated relative error of ``name`` at ``t``: ``dict(total=, space=, time=)``.
+
+        Linear in time between the steps of :attr:`estimate` (set by
+        :func:`femehl.auto.solve_to_tolerance`, see there for the estimators).
+        """
+        est = self.estimate
+        if est is None:
+            raise SceneError(
+                "this result carries no error estimate: run with femehl.auto.solve_to_tolerance."
+            )
+        if name not in est or name == "t":
+            names = [k for k in est if k != "t"]
+            raise SceneError(f"no error estimate for {name!r}: uncertainty takes one of {names}.")
+        ts = np.asarray(est["t"], dtype=float)
+        t = float(t)
+        tol = 1e-9 * max(1.0, abs(ts[-1]))
+        if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
+            raise SceneError(f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}].")
+        return {k: float(np.interp(t, ts, est[name][k])) for k in ("total", "space", "time")}
 
     def save(self, folder, *, overwrite: bool = False) -> pathlib.Path:
         """Write the summary CSV, the field series and the PNGs to ``folder``.

@@ -12,7 +12,7 @@ reference).  Quick start::
     result.pressure_at([[0.0, 0.0], [-1.0, 0.0]], t=2.0)
 """
 
-from . import indenters, line, presets
+from . import auto, indenters, line, presets
 from .api import make_stepper, methods, solve, solve_line, steps
 from .discretizations import METHODS
 from .errors import (
@@ -47,6 +47,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "presets",
+    "auto",
     "indenters",
     "line",
     "solve",

@@ -49,22 +49,24 @@ import numpy as np  # noqa: E402
 import femehl  # noqa: E402
 from femehl.fe.fitted import contact_extent, fitted_disk  # noqa: E402
 from femehl.fe.mesh import LADDER_RATIO, load_mesh  # noqa: E402
-from femehl.indenters import Ellipsoid  # noqa: E402
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart  # noqa: E402
 
 HERE = pathlib.Path(__file__).resolve().parent
 T_END, DT = 3.0, 0.01
 
 
-def ellipsoid(Rx, Ry, h_end=-0.5, beta=200.0):
-    """The shipped ellipsoid example's scene (examples/ellipsoid_sliding.py)."""
-    return Scene(
-        indenter=Ellipsoid(Rx, Ry),
-        substrate=HalfSpace(0.5),
-        fluid=Fluid(beta),
-        motion=Motion(gap=RampHold(0.1, h_end, 1.0), velocity=TanhStart(1.0, 1.0)),
-        domain=Domain(2.0),
+def _example_scene():
+    """``scene(Rx, Ry, h_end, beta)`` of the shipped example examples/ellipsoid_sliding.py."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "femehl_example_ellipsoid", HERE.parent / "examples" / "ellipsoid_sliding.py"
     )
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.scene
+
+
+ellipsoid = _example_scene()
 
 
 SCENES = {

@@ -136,31 +136,33 @@ class Result:
         val = sum(wt * self.disc.pressure_at(s.p, pts) for s, wt in self._bracket(t))
         return np.where(out, 0.0, val)
 
-    def deflection_at(self, points, t: float) -> np.ndarray:
-        """Surface deflection w (negative under pressure) at ``points`` and time ``t``."""
+    def _element_field(self, points, t, inside, outside):
+        """Blend in time ``inside(state, pts)`` within the domain, ``outside(state, pts)`` beyond it."""
         pts = self._points(points)
         out = self._outside(pts)
         val = np.zeros(pts.shape[0])
         for s, wt in self._bracket(t):
             v = np.empty(pts.shape[0])
-            v[~out] = self.disc.deflection_at(s.w, pts[~out])
+            v[~out] = inside(s, pts[~out])
             if out.any():
-                v[out] = self._model_deflection(s, pts[out])
+                v[out] = outside(s, pts[out])
             val += wt * v
         return val
 
+    def deflection_at(self, points, t: float) -> np.ndarray:
+        """Surface deflection w (negative under pressure) at ``points`` and time ``t``."""
+        return self._element_field(
+            points, t, lambda s, q: self.disc.deflection_at(s.w, q), self._model_deflection
+        )
+
     def film_at(self, points, t: float) -> np.ndarray:
         """Film thickness d = h - w at ``points`` (n, 2) and time ``t``."""
-        pts = self._points(points)
-        out = self._outside(pts)
-        val = np.zeros(pts.shape[0])
-        for s, wt in self._bracket(t):
-            v = np.empty(pts.shape[0])
-            v[~out] = self.disc.film_at(s.d, pts[~out])
-            if out.any():
-                v[out] = s.hc + self.disc.gap(pts[out]) - self._model_deflection(s, pts[out])
-            val += wt * v
-        return val
+        return self._element_field(
+            points,
+            t,
+            lambda s, q: self.disc.film_at(s.d, q),
+            lambda s, q: s.hc + self.disc.gap(q) - self._model_deflection(s, q),
+        )
 
     # ---- tables -------------------------------------------------------------
     def summary(self) -> dict:

@@ -82,7 +82,7 @@ def test_rigid_and_winkler_build_no_dense_matrix():
         sc = Scene(substrate=sub, motion=Motion(gap=RampHold(0.5, 0.1, 1.0)))
         st = femehl.make_stepper(sc, "fe", mesh="medium")
         st._film_product(st.terms[[t.name for t in st.terms].index("couette")])
-        for op in (st.C, *st._FC.values()):
+        for op in (st.C, *st.film_products.values()):
             assert sp.issparse(op)
         assert st.info["operator_bytes"] < 50 * st.disc.nnodes * 8 * 10
 

@@ -275,7 +275,7 @@ def test_combination_runs(indenter, substrate, control, sliding):
         assert isinstance(st.C, np.ndarray)
     else:
         assert sp.issparse(st.C) and not st.dense
-        assert all(sp.issparse(v) for v in st._FC.values())
+        assert all(sp.issparse(v) for v in st.film_products.values())
     loads = np.array([s.load for s in states[1:]])
     if control == "load":
         target = np.array([min(s.t / 0.1, 1.0) * F for s in states[1:]])

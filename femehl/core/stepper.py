@@ -124,16 +124,21 @@ class LaggedStepper:
         self.info["setup_s"] = disc.info.get("setup_s", 0.0) + time.perf_counter() - t0
 
     # ---- operators ----------------------------------------------------------------------
+    @property
+    def film_products(self) -> dict:
+        """The fixed products ``F C`` formed so far, by term name (dense or sparse)."""
+        return {name: FC for name, (_, FC) in self._FC.items()}
+
     def _film_product(self, term):
-        """``F C`` of a term, formed the first time it is needed (per term name)."""
-        FC = self._FC.get(term.name)
-        if FC is None:
+        """``(F, F C)`` of a term, asked of the term and formed once, the first time needed."""
+        pair = self._FC.get(term.name)
+        if pair is None:
             F = term.film_operator()
             FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
-            self._FC[term.name] = FC
+            pair = self._FC[term.name] = (F, FC)
             self.info["operator_bytes"] += _nbytes(FC)
             self.info[f"{term.name}_assembled"] = True
-        return FC
+        return pair
 
     def operator(self, ctx: StepContext):
         """The step's :class:`StepOperator` and its right-hand side without the ``-G h`` part."""
@@ -145,7 +150,7 @@ class LaggedStepper:
             if c.matrix is not None:
                 D = c.matrix if D is None else D + c.matrix
             if c.film_coefficient != 0.0:
-                films.append((c.film_coefficient, term.film_operator(), self._film_product(term)))
+                films.append((c.film_coefficient, *self._film_product(term)))
             if c.rhs is not None:
                 rhs += c.rhs
         if D is None:

@@ -1,94 +1,299 @@
-"""femehl.auto.solve_to_tolerance on a few scenes at tol = 1e-2: cost, estimated and true error.
+"""``femehl bench auto``: automatic accuracy (``femehl.solve(scene, tol=...)``) on many scenes.
 
-True errors are against benchmarks/auto_reference.json (benchmarks/auto_reference.py);
-scenes without a reference show "n/a".  Writes benchmarks/auto_results.md.
+For every scene of ``benchmarks/auto_scenes.py`` and every ``tol``: the automatic run's
+wall time, cells and steps of each of its runs, rejected steps, and, per headline
+quantity (load, film_center, film_min), the estimated error (max over the steps of
+``result.uncertainty(q, t)["total"]``) and the true error (max over the steps of the
+relative difference to the converged reference of
+``benchmarks/auto_reference_scenes.json``, whose own uncertainty is stated), and the
+share of steps where the estimate is at least half the true error.  Beside it, the
+cheapest hand-tuned setting (fitted mesh level x fixed BDF2 step, a small grid) whose
+true error is within ``tol`` and within the automatic run's error, and its wall time.
 
-Run:  OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/auto.py [scene ...]
+Each run is its own subprocess with one BLAS thread; records go to ``auto_runs.jsonl``
+(``--resume`` skips those present), then ``auto_results.md`` and ``auto_results.png``.
+
+Run::
+
+    femehl bench auto                       # tol 1e-2 and 1e-3, every scene, + hand grid
+    femehl bench auto --tol 1e-2 --only paper,ellipsoid_x
+    femehl bench auto --no-hand             # automatic runs only
+    femehl bench auto --analyze-only        # tables and plot from auto_runs.jsonl
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import pathlib
+import platform
 import subprocess
 import sys
 import time
 
-import numpy as np
-
-sys.path.insert(0, str(pathlib.Path(__file__).parents[1]))
-
-import femehl  # noqa: E402
-from femehl import Ellipsoid, Motion, RampHold, Scene, TanhStart  # noqa: E402
-from femehl.auto import QUANTITIES, solve_to_tolerance  # noqa: E402
-
-HERE = pathlib.Path(__file__).parent
-T_END, TOL = 1.5, 1e-2
-
-
-def scenes() -> dict:
-    """The benchmark scenes (the first two have a reference)."""
-    ell = Motion(gap=RampHold(0.1, -0.5, 1.0), velocity=TanhStart(1.0, 1.0))
-    return {
-        "sphere": femehl.presets.paper_sphere(),
-        "ellipsoid": Scene(indenter=Ellipsoid(0.5, 2.0), motion=ell),
-        "ellipsoid_rotated": Scene(indenter=Ellipsoid(2.0, 0.5), motion=ell),
-        "sphere_beta20": femehl.presets.paper_sphere(beta=20.0),
-    }
+HERE = pathlib.Path(__file__).resolve().parent
+RUNS = HERE / "auto_runs.jsonl"
+REFERENCE = HERE / "auto_reference_scenes.json"
+QUANTITIES = ("load", "film_center", "film_min")
+#: the hand-tuned grid: fitted mesh levels x fixed BDF2 steps
+HAND_LEVELS = (2.0, 1.41, 1.0, 0.71)
+HAND_DT = (0.02, 0.01)
+#: the automatic runs' budget of cells (femehl.auto.MAX_ELEMENTS is 25,000)
+MAX_CELLS = 25_000
 
 
-def true_error(res, ref, q) -> tuple[float, float]:
-    """Largest relative error of ``q`` against the reference over the steps t > 0, and the
-    fraction of those steps where the estimated total is >= half the true error."""
-    qr = np.interp(res.t[1:], ref["t"], ref[q])
-    scale = np.maximum(np.abs(qr), 0.1 if q == "load" else 0.0)
-    true = np.abs(getattr(res, q)[1:] - qr) / scale
-    return float(np.max(true)), float(np.mean(res.estimate[q]["total"][1:] >= 0.5 * true))
+def _scenes():
+    sys.path.insert(0, str(HERE))
+    from auto_scenes import SCENES
+
+    return SCENES
 
 
-def row(name, scene, refs) -> str:
+# ---- worker -------------------------------------------------------------------------
+def worker(spec: dict) -> dict:
+    """One run (in this process): ``kind`` "auto" (tol) or "hand" (level, dt)."""
+    import numpy as np
+
+    import femehl
+    from femehl.fe.fitted import fitted_disk
+
+    factory, t_end = _scenes()[spec["scene"]]
+    scene = factory()
     t0 = time.perf_counter()
-    res = solve_to_tolerance(scene, t_end=T_END, tol=TOL, store_every=0, max_elements=13_000)
-    wall = time.perf_counter() - t0
-    a = res.info["auto"]
-    cells = []
+    out = dict(spec, status="ok")
+    try:
+        if spec["kind"] == "auto":
+            res = femehl.solve(scene, t_end=t_end, tol=spec["tol"], store_every=0, max_elements=MAX_CELLS)
+        else:
+            mesh = fitted_disk(scene, t_end, level=spec["level"])
+            res = femehl.solve(scene, t_end=t_end, dt=spec["dt"], scheme="bdf2", mesh=mesh, store_every=0)
+    except femehl.FemehlError as exc:
+        res = getattr(exc, "result", None)
+        out.update(status=f"{type(exc).__name__}: {exc}")
+    out["wall_s"] = time.perf_counter() - t0
+    if res is not None:
+        out["t"] = res.t.tolist()
+        out.update({q: getattr(res, q).tolist() for q in QUANTITIES})
+        out["elements"] = res.info.get("elements")
+        out["steps"] = res.nsteps
+        if res.estimate is not None and res.estimate["load"]["total"] is not None:
+            out["estimate"] = {q: np.asarray(res.estimate[q]["total"]).tolist() for q in QUANTITIES}
+        if "auto" in res.info:
+            out["auto"] = {k: v for k, v in res.info["auto"].items()}
+    return out
+
+
+def run_in_subprocess(spec: dict) -> dict:
+    env = dict(os.environ)
+    for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[v] = "1"
+    env.setdefault("MPLBACKEND", "Agg")
+    cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "--worker", json.dumps(spec)]
+    t = time.perf_counter()
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    if p.returncode != 0:
+        tail = p.stderr.strip().splitlines()[-1:] or ["?"]
+        return dict(spec, status=f"crashed: {tail[0]}", wall_s=time.perf_counter() - t)
+    rec = json.loads(p.stdout.strip().splitlines()[-1])
+    rec["loadavg"] = os.getloadavg()
+    return rec
+
+
+# ---- errors against the reference ------------------------------------------------------
+def _ref(refs: dict, name: str):
+    r = refs.get(name)
+    if not r or "reference" not in r:
+        return None
+    return r
+
+
+def true_errors(rec: dict, ref: dict) -> dict:
+    """Per quantity: max relative error over the steps t > 0 and the share where est >= true/2."""
+    import numpy as np
+
+    out = {}
+    t = np.asarray(rec["t"])[1:]
+    tr = np.asarray(ref["t"])
+    keep = t <= tr[-1] + 1e-9
     for q in QUANTITIES:
-        est = float(np.max(res.estimate[q]["total"])) if res.estimate else float("nan")
-        tru = "n/a"
-        if name in refs and res.estimate:
-            err, share = true_error(res, refs[name], q)
-            tru = f"{err:.2%} ({share:.0%})"
-        cells.append(f"{est:.2%} / {tru}")
-    runs = " | ".join("/".join(map(str, a[k])) for k in ("elements", "steps", "rejected_steps"))
-    line = f"| {name} | {a['reached']} | {wall:.0f} | {runs} | " + " | ".join(cells) + " |"
-    print(line, flush=True)
-    return line
+        qr = np.interp(t[keep], tr, np.asarray(ref["reference"][q]))
+        scale = np.maximum(np.abs(qr), 0.1 if q == "load" else 0.0)
+        true = np.abs(np.asarray(rec[q])[1:][keep] - qr) / scale
+        entry = {"true": float(np.max(true)) if true.size else float("nan")}
+        if "estimate" in rec:
+            est = np.asarray(rec["estimate"][q])[1:][keep]
+            entry["estimate"] = float(np.max(est))
+            entry["share"] = float(np.mean(est >= 0.5 * true))
+        out[q] = entry
+    return out
 
 
 def machine() -> str:
-    model = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-    model = next((s.split(":", 1)[1].strip() for s in model.splitlines() if s.startswith("Model name")), "?")
-    return f"nproc = {os.cpu_count()}, {model}, OMP/OPENBLAS threads = {os.environ.get('OMP_NUM_THREADS')}"
+    model = "?"
+    try:
+        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import numpy
+    import scipy
+
+    return (
+        f"{os.cpu_count()} cores ({model}), python {platform.python_version()}, numpy {numpy.__version__}, "
+        f"scipy {scipy.__version__}, 1 BLAS thread per run"
+    )
 
 
-def main(names) -> None:
-    refs = json.loads((HERE / "auto_reference.json").read_text())
-    head = [
-        f"# solve_to_tolerance at tol = {TOL:g}, t_end = {T_END:g}",
+def _pct(x) -> str:
+    return "n/a" if x is None or x != x else f"{100 * x:.2g} %"
+
+
+def _status(r: dict) -> str:
+    if r.get("status") != "ok":
+        return r.get("status", "?")[:80]
+    return "reached" if r.get("auto", {}).get("reached") else "not reached (budget)"
+
+
+def cheapest(hand: list, r: dict, ref, limit: float) -> str:
+    """The cheapest hand-tuned run of ``r``'s scene whose worst true error is <= ``limit``."""
+    ok = []
+    for h in hand:
+        if h["scene"] != r["scene"] or not ref:
+            continue
+        he = true_errors(h, ref)
+        if max(he[q]["true"] for q in QUANTITIES) <= limit:
+            ok.append(h)
+    if not ok:
+        return "none in the grid"
+    h = min(ok, key=lambda h: h["wall_s"])
+    ratio = r["wall_s"] / h["wall_s"]
+    return f"level {h['level']:g}, dt {h['dt']:g}: {h['wall_s']:.1f} s (auto {ratio:.2g}x)"
+
+
+def analyze(records: list, refs: dict) -> str:
+    """The markdown tables; also writes the plot."""
+    scenes = _scenes()
+    lines = [
+        "# Automatic accuracy: `femehl.solve(scene, tol=...)` on the benchmark scenes",
         "",
-        f"Machine: {machine()} (shared with another job: wall times are loaded).",
-        "Columns per quantity: max over t of the estimated total / true relative error (in",
-        "parentheses: the share of steps where the estimate is >= half the true error).",
-        "elements, steps, rejected: per level run (coarse to fine).",
+        f"Generated by `femehl bench auto` (benchmarks/auto.py). Machine: {machine()}; "
+        "wall times are of a shared 2-core machine (load average per run in auto_runs.jsonl).",
         "",
-        "| scene | reached | wall s | elements | steps | rejected | load | film_center | film_min |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "True error: max over the steps of |q - q_ref| / |q_ref| (load: / max(|q_ref|, 0.1)) "
+        "against benchmarks/auto_reference_scenes.json; its own uncertainty (max over t) in "
+        "the last column.  est / true per quantity; in brackets the share of steps where "
+        "the estimate is >= half the true error.",
+        "",
+        "| scene | tol | status | wall s | cells (runs) | steps | rejected | load est / true | "
+        "film_center est / true | film_min est / true | hand-tuned cheapest <= tol | hand <= auto's error "
+        "| ref. uncertainty |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    print("\n".join(head), flush=True)
-    lines = [row(n, scenes()[n], refs) for n in names]
-    (HERE / "auto_results.md").write_text("\n".join(head + lines) + "\n")
+    hand = [r for r in records if r["kind"] == "hand" and r.get("status") == "ok"]
+    points = []
+    for r in [r for r in records if r["kind"] == "auto"]:
+        ref = _ref(refs, r["scene"])
+        a = r.get("auto", {})
+        errs = true_errors(r, ref) if ref and "t" in r else {}
+        cells = []
+        for q in QUANTITIES:
+            e = errs.get(q, {})
+            share = f" ({e['share']:.0%})" if "share" in e else ""
+            cells.append(f"{_pct(e.get('estimate'))} / {_pct(e.get('true'))}{share}")
+            if "share" in e:
+                points.append((r["tol"], q, e["estimate"], e["true"], r["scene"]))
+        worst = max((errs[q]["true"] for q in errs), default=float("nan"))
+
+        unc = ref.get("uncertainty", {}) if ref else {}
+        lines.append(
+            f"| {r['scene']} | {r['tol']:g} | {_status(r)} | "
+            f"{r['wall_s']:.0f} | {'/'.join(map(str, a.get('elements', [])))} | "
+            f"{'/'.join(map(str, a.get('steps', [])))} | {'/'.join(map(str, a.get('rejected_steps', [])))} | "
+            + " | ".join(cells)
+            + f" | {cheapest(hand, r, ref, r['tol'])} | {cheapest(hand, r, ref, worst)} | "
+            + ", ".join(f"{q} {_pct(unc.get(q))}" for q in QUANTITIES)
+            + " |"
+        )
+    lines += ["", "Scenes: " + ", ".join(f"{k} (t_end {v[1]:g})" for k, v in scenes.items()), ""]
+    _plot(points)
+    return "\n".join(lines) + "\n"
+
+
+def _plot(points) -> None:
+    if not points:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 5))
+    marks = {"load": "o", "film_center": "s", "film_min": "^"}
+    for tol, q, est, true, _ in points:
+        ax.scatter(max(true, 1e-6), max(est, 1e-6), marker=marks[q], c="C0" if tol >= 1e-2 else "C1", s=25)
+    lim = (1e-6, 1e-1)
+    ax.plot(lim, lim, "k-", lw=0.8, label="estimate = true")
+    ax.plot(lim, [v / 2 for v in lim], "k--", lw=0.8, label="estimate = true / 2")
+    for tol in sorted({p[0] for p in points}):
+        ax.axvline(tol, color="C0" if tol >= 1e-2 else "C1", lw=0.8, ls=":", label=f"tol = {tol:g}")
+    ax.set(xscale="log", yscale="log", xlim=lim, ylim=lim, xlabel="true error (max over t)")
+    ax.set_ylabel("estimated error (max over t)")
+    ax.set_title("femehl automatic accuracy: o load, s central, ^ minimum film")
+    ax.legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(HERE / "auto_results.png", dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(prog="femehl bench auto", description=__doc__.splitlines()[0])
+    ap.add_argument("--worker", help=argparse.SUPPRESS)
+    ap.add_argument("--tol", default="1e-2,1e-3", help="comma-separated tolerances")
+    ap.add_argument("--only", help="comma-separated scene names")
+    ap.add_argument("--no-hand", action="store_true", help="skip the hand-tuned grid")
+    ap.add_argument("--resume", action="store_true", help="skip runs already in auto_runs.jsonl")
+    ap.add_argument("--analyze-only", action="store_true")
+    args = ap.parse_args(argv)
+    if args.worker:
+        print(json.dumps(worker(json.loads(args.worker))))
+        return
+    names = list(_scenes()) if not args.only else args.only.split(",")
+    unknown = sorted(set(names) - set(_scenes()))
+    if unknown:
+        raise SystemExit(f"femehl bench auto: unknown scene(s) {unknown}; known: {sorted(_scenes())}")
+    records = [json.loads(s) for s in RUNS.read_text().splitlines()] if RUNS.is_file() else []
+    if not args.analyze_only:
+        specs = [dict(kind="auto", scene=n, tol=float(t)) for t in args.tol.split(",") for n in names]
+        if not args.no_hand:
+            specs += [
+                dict(kind="hand", scene=n, level=lv, dt=dt)
+                for n in names
+                for lv in HAND_LEVELS
+                for dt in HAND_DT
+            ]
+        done = {
+            json.dumps({k: r[k] for k in r if k in ("kind", "scene", "tol", "level", "dt")}, sort_keys=True)
+            for r in records
+        }
+        if not args.resume:
+            records, done = [], set()
+            RUNS.write_text("")
+        for spec in specs:
+            if json.dumps(spec, sort_keys=True) in done:
+                continue
+            rec = run_in_subprocess(spec)
+            print(f"{spec}: {rec.get('status')}, {rec.get('wall_s', 0):.1f} s", flush=True)
+            records.append(rec)
+            with open(RUNS, "a") as fh:
+                fh.write(json.dumps(rec) + "\n")
+    refs = json.loads(REFERENCE.read_text()) if REFERENCE.is_file() else {}
+    text = analyze(records, refs)
+    (HERE / "auto_results.md").write_text(text)
+    print(text)
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or list(scenes()))
+    main()

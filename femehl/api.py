@@ -72,6 +72,25 @@ def steps(scene: Scene, t_end: float, dt: float, method: str | None = None, **op
     yield from march(stepper, t_end, dt)
 
 
+#: the accuracy of a run that states neither its discretization nor its time step
+DEFAULT_TOL = 1e-2
+
+
+def discretization_options(method: str) -> set[str]:
+    """The option names of ``method``'s discretization (its constructor's parameters)."""
+    return set(inspect.signature(_registry()[method]).parameters) - {"scene"}
+
+
+def is_automatic(scene, method: str | None, dt, options) -> bool:
+    """True when femehl chooses the discretization: no ``dt`` and none of its options given."""
+    from .auto import LADDERS
+
+    method = scene.default_method if method is None else method
+    if method not in _registry():
+        raise SceneError(f"unknown method {method!r}: choose one of {sorted(_registry())}.")
+    return dt is None and method in LADDERS and not (discretization_options(method) & set(options))
+
+
 def solve(
     scene: Scene,
     method: str | None = None,
@@ -85,26 +104,41 @@ def solve(
 ) -> Result:
     """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.result.Result`.
 
+    Two modes:
+
+    * **automatic** (neither ``dt`` nor a discretization option such as ``mesh`` is
+      given): femehl chooses the mesh and the time steps so that the load, central and
+      minimum film are within ``tol`` (default 1e-2) at every step
+      (:func:`femehl.auto.solve_to_tolerance`); the result carries the error estimate,
+      ``result.uncertainty(name, t)``;
+    * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
+      discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
+      ``tol`` is given (the result then carries the time part of the estimate).
+
     Parameters
     ----------
     scene : femehl.Scene
         The problem (see :mod:`femehl.scene`, :mod:`femehl.presets`).
     method : str, default: "fe"
         A key of :data:`femehl.discretizations.METHODS`: "fe" (finite elements, default
-        for a 2-D scene), "fd" (the paper's polar finite differences) or "line" (line
-        contact, the default for a :class:`femehl.line.LineScene`).
+        for a 2-D scene), "fd" (the paper's polar finite differences, expert mode only)
+        or "line" (line contact, the default for a :class:`femehl.line.LineScene`).
     t_end : float, default: 5.0
         End time (normalized).
     dt : float, optional
-        Fixed time step (default 0.01, the paper's value); with ``tol``, the first step.
+        Fixed time step (expert mode; default 0.01, the paper's value); with ``tol``, the
+        first step.
     tol : float, optional
-        Adaptive time steps (:mod:`femehl.core.adaptive`) to this relative local error
-        per unit time; the scheme is then BDF2 unless given.  ``dt_min``, ``dt_max`` and
-        ``safety`` tune the controller.
+        Automatic mode: the relative accuracy (default 1e-2).  Expert mode: adaptive time
+        steps (:mod:`femehl.core.adaptive`) to this relative local error per unit time;
+        the scheme is then BDF2 unless given.  ``dt_min``, ``dt_max`` and ``safety`` tune
+        the controller.
     store_every : int, default: 1
         Keep the fields of every ``store_every``-th step (and the last); 0 keeps none.
     callback : callable, optional
-        Called with each State as it is produced (progress bars, writers).
+        Called with each State as it is produced (progress bars, writers); in automatic
+        mode with the States of every run (``state.info`` has no level: use
+        ``result.info["auto"]`` afterwards).
     **options
         Options of the method (FD ``dr``, ``dtheta``; FE ``mesh``; line ``n_elements``)
         and of the stepper (``scheme``, ``linear_solver``, ``terms``, ...).
@@ -112,6 +146,18 @@ def solve(
     from .core.adaptive import CONTROLS
     from .stepping import check_run
 
+    if is_automatic(scene, method, dt, options):
+        from .auto import solve_to_tolerance
+
+        return solve_to_tolerance(
+            scene,
+            t_end=t_end,
+            tol=DEFAULT_TOL if tol is None else tol,
+            method=method,
+            store_every=store_every,
+            callback=callback,
+            **options,
+        )
     controls = {k: options.pop(k) for k in CONTROLS if k in options}
     if tol is None:
         dt = 0.01 if dt is None else dt
@@ -119,7 +165,12 @@ def solve(
     else:
         options.setdefault("scheme", "bdf2")
     stepper = make_stepper(scene, method, **options)
-    return run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
+    result = run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
+    if tol is not None:
+        from .auto import time_estimate
+
+        result.estimate = time_estimate(result)
+    return result
 
 
 def run_loop(

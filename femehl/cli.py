@@ -1,8 +1,10 @@
 """Command line: ``femehl run [SCENE.toml]`` (and ``femehl bench ...``).
 
 ``femehl run`` without a file runs the built-in default: the paper's sphere
-(beta = 200, h0 = 0.1) to t = 5 with the FE solver on the "medium" mesh,
-which takes well under a minute here.  Options override the file's [run].
+(beta = 200, h0 = 0.1) to t = 5 with the FE solver, automatically to 1 %
+(``--tol 0.01``: femehl chooses the mesh and the time steps and reports its error
+estimate; see :mod:`femehl.auto`).  ``--mesh``, ``--n-elements``, ``--dt`` (or
+``--method fd``) choose the discretization by hand instead (expert mode).  Options override the file's [run].
 Exit status: 0 done, 2 bad input (nothing written), 3 the run stopped (film
 rupture, singular system) after writing what it had, 130 interrupted (Ctrl-C:
 what was written stays readable and the command to resume is printed).
@@ -42,16 +44,21 @@ def _parser():
     r.add_argument(
         "--method", choices=["fe", "fd", "line"], help="solver (default fe; line contact scenes: line)"
     )
-    r.add_argument("--mesh", help="FE mesh: coarse|medium|fine|xfine or a mesh file (default medium)")
+    r.add_argument(
+        "--mesh",
+        help="FE mesh: coarse|medium|fine|xfine|fitted or a mesh file (default: chosen from --tol)",
+    )
     r.add_argument("--dr", type=float, help="FD radial step (default 0.0125)")
     r.add_argument("--dtheta-divisions", type=int, help="FD: dtheta = pi/N (default 36)")
-    r.add_argument("--n-elements", type=int, help="line contact: number of elements (default 400)")
-    r.add_argument("--dt", type=float, help="time step (default 0.01)")
+    r.add_argument(
+        "--n-elements", type=int, help="line contact: number of elements (default: chosen from --tol)"
+    )
+    r.add_argument("--dt", type=float, help="fixed time step (expert mode; default 0.01 with --mesh)")
     r.add_argument(
         "--tol",
         type=float,
-        help="adaptive time steps to this relative error per unit time (e.g. 0.01); "
-        "--dt is then the first step",
+        help="relative accuracy of load and films (default 0.01: femehl chooses mesh and steps); "
+        "with --mesh/--dt: adaptive time steps to this local error per unit time",
     )
     r.add_argument(
         "--scheme",
@@ -71,7 +78,7 @@ def _parser():
         help="replace the run already in the output folder (its femehl files only)",
     )
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
-    b.add_argument("what", choices=["accuracy", "stress", "fitted_mesh"], help="which study")
+    b.add_argument("what", choices=["accuracy", "stress", "fitted_mesh", "auto"], help="which study")
     b.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
@@ -152,8 +159,6 @@ def _run(args, argv=()):
         # (coarser ones rupture at the exit: see the FD module docstring)
         run.setdefault("dr", 0.0125)
         run.setdefault("dtheta", math.pi / 36)
-    elif method == "fe":
-        run.setdefault("mesh", "medium")
     out = args.out or f"{DEFAULT_OUT}/{name}"
     try:
         res = run_to_folder(
@@ -179,13 +184,41 @@ def _run(args, argv=()):
     )
     if dim is not None:
         print(f"femehl: wrote {_write_si_summary(dim, _SummaryFile(out), out)} (SI units)")
+    _print_choice(res)
     for t in sorted({1.0, float(res.t[-1])}):
         if res.t[0] - 1e-9 <= t <= res.t[-1] + 1e-9:  # a resumed run starts at its checkpoint
             print(
-                f"  t = {t:g}: load {res.value_at('load', t):.5g}, central film "
-                f"{res.value_at('film_center', t):.5g}, minimum film {res.value_at('film_min', t):.5g}"
+                f"  t = {t:g}: load {_with_error(res, 'load', t)}, central film "
+                f"{_with_error(res, 'film_center', t)}, minimum film {_with_error(res, 'film_min', t)}"
             )
     return 0
+
+
+def _print_choice(res) -> None:
+    """What an automatic run chose, and its estimated error."""
+    a = res.info.get("auto")
+    if not a or "levels" not in a:
+        return
+    runs = ", ".join(
+        f"{n} cells / {k} steps / {w:.1f} s"
+        for n, k, w in zip(a["elements"], a["steps"], a["wall"], strict=True)
+    )
+    status = "reached" if a["reached"] else "NOT reached (budget)"
+    print(
+        f"femehl: automatic to tol = {a['tol']:g} ({status}): runs {runs}; the answer is the last "
+        f"(estimated error up to {100 * a.get('total', float('nan')):.2g} %)"
+    )
+
+
+def _with_error(res, name: str, t: float) -> str:
+    """``0.04112 (+-0.35 %)``: the value and its estimated relative error, where estimated."""
+    v = f"{res.value_at(name, t):.5g}"
+    if res.estimate is None:
+        return v
+    u = res.uncertainty(name, t)
+    if u["total"] is not None:
+        return f"{v} (+-{100 * u['total']:.2g} %)"
+    return f"{v} (time part +-{100 * u['time']:.2g} %)"
 
 
 class _SummaryFile:

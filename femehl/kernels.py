@@ -39,7 +39,8 @@ def _edge_term(ax, ay, bx, by, cx, cy):
     ex = cx - bx
     ey = cy - by
     le = np.hypot(ex, ey)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # (overflow: A at a subnormal distance from the line BC; masked below like h = 0)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         ex = ex / le
         ey = ey / le
         dbx = bx - ax

@@ -20,6 +20,8 @@ from .stepping import State
 __all__ = ["Result"]
 
 _SCALARS = ("t", "hc", "V", "load", "film_center", "film_min", "p_max")
+#: per-step records of the time stepping (``state.info``): step size and local error estimate
+_STEPPING = ("dt", "error_estimate")
 
 
 @dataclass
@@ -38,11 +40,14 @@ class Result:
     scene: object
     method: str
     disc: object
-    _rows: dict = field(default_factory=lambda: {k: [] for k in _SCALARS + ("film_min_at", "p_max_at")})
+    _rows: dict = field(
+        default_factory=lambda: {k: [] for k in _SCALARS + _STEPPING + ("film_min_at", "p_max_at")}
+    )
     _stored: list = field(default_factory=list)
     info: dict = field(default_factory=dict)
-    #: error estimate of :func:`femehl.auto.solve_to_tolerance` (None otherwise):
-    #: ``{"t": times, name: {"space": ..., "time": ..., "total": ...}}``, relative errors
+    #: error estimate (:mod:`femehl.auto`; None for a fixed-step expert run):
+    #: ``{"t": times, name: {"space": ..., "time": ..., "total": ...}}``, relative errors;
+    #: an expert run with adaptive steps has the time part only (``space``, ``total`` None)
     estimate: dict | None = None
 
     def record(self, state: State, store_fields: bool = True) -> None:
@@ -51,6 +56,9 @@ class Result:
             self._rows[k].append(float(getattr(state, k)))
         self._rows["film_min_at"].append(tuple(state.film_min_at))
         self._rows["p_max_at"].append(tuple(state.p_max_at))
+        info = state.info or {}
+        self._rows["dt"].append(float(info.get("dt", 0.0)))
+        self._rows["error_estimate"].append(float(info.get("error_estimate", np.nan)))
         if store_fields:
             self._stored.append(state)
 
@@ -189,13 +197,16 @@ class Result:
     def uncertainty(self, name: str, t: float) -> dict:
         """Estimated relative error of ``name`` at ``t``: ``dict(total=, space=, time=)``.
 
-        Linear in time between the steps of :attr:`estimate` (set by
-        :func:`femehl.auto.solve_to_tolerance`, see there for the estimators).
+        Linear in time between the steps of :attr:`estimate` (see :mod:`femehl.auto` for
+        the estimators).  An automatic run (:func:`femehl.solve` without ``dt`` or mesh
+        options) has all three parts; an expert run with adaptive steps (``tol`` and a
+        mesh) only the time part, its ``space`` and ``total`` are None.
         """
         est = self.estimate
         if est is None:
             raise SceneError(
-                "this result carries no error estimate: run with femehl.auto.solve_to_tolerance."
+                "this result carries no error estimate: run femehl.solve without dt= and mesh "
+                "options (automatic, to tol), or give tol= for the time part."
             )
         if name not in est or name == "t":
             names = [k for k in est if k != "t"]
@@ -205,7 +216,10 @@ class Result:
         tol = 1e-9 * max(1.0, abs(ts[-1]))
         if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
             raise SceneError(f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}].")
-        return {k: float(np.interp(t, ts, est[name][k])) for k in ("total", "space", "time")}
+        return {
+            k: None if est[name][k] is None else float(np.interp(t, ts, est[name][k]))
+            for k in ("total", "space", "time")
+        }
 
     def save(self, folder, *, overwrite: bool = False) -> pathlib.Path:
         """Write the summary CSV, the field series and the PNGs to ``folder``.

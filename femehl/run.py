@@ -109,7 +109,7 @@ def run_to_folder(
     method : str, default: "fe"
     t_end : float, default: 5.0
     dt : float, optional
-        Time step (default 0.01); with ``tol`` the first step (default: the controller's).
+        Fixed time step (expert mode, default 0.01); with ``tol`` the first step.
     store_every : int, default: 10
         Fields are kept and written every ``store_every`` steps (and at the end).
     progress : bool, default: False
@@ -128,11 +128,16 @@ def run_to_folder(
         Replace a run already in ``folder`` (its femehl files are removed first; other
         files are left alone).  Without it such a folder is refused with OutputError.
     tol : float, optional
-        Adaptive time steps to this relative error per unit time
+        Automatic mode (neither ``dt`` nor a discretization option given, as
+        :func:`femehl.solve`): the relative accuracy, default 1e-2; the coarse pilot runs
+        stay in memory, each run that may be the answer is written here as it goes (a
+        finer one replaces it), and at the end ``summary.csv`` gets the error estimate
+        columns (:data:`femehl.output.table.ERROR_COLUMNS`) and ``auto.json`` what was
+        chosen.  Expert mode: adaptive time steps to this relative error per unit time
         (:mod:`femehl.core.adaptive`); ``dt`` is then the first step and the scheme BDF2
         unless given.  ``store_every`` and ``checkpoint_every`` count accepted steps.
     **options
-        Discretization options of the method (``mesh``, ``dr``, ``dtheta``, ...).
+        Discretization options of the method (``mesh``, ``dr``, ``dtheta``, ...): expert mode.
 
     Raises
     ------
@@ -141,20 +146,161 @@ def run_to_folder(
     SolverError, KeyboardInterrupt
         The run stopped: ``exc.result`` is the partial Result, the files stay readable.
     """
+    from .api import DEFAULT_TOL, is_automatic
+
     tol = check_tol(tol)
+    resume, overwrite = check_resume_overwrite(resume, overwrite)
+    say = _reporter(log)
+    common = dict(
+        method=method,
+        t_end=t_end,
+        store_every=store_every,
+        progress=progress,
+        say=say,
+        checkpoint_every=checkpoint_every,
+        options=options,
+    )
+    saved_auto = None
+    if resume:
+        saved_auto = checkpoint.read_params(check_folder(folder, resume=True)).get("auto")
+    if saved_auto is None and not is_automatic(scene, method, dt, options):
+        return _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
+    if dt is not None:
+        raise SceneError("an automatic run chooses its time steps: leave dt out (or give the mesh too).")
+    return _automatic(
+        scene,
+        folder,
+        tol=DEFAULT_TOL if tol is None else tol,
+        resume=resume,
+        overwrite=overwrite,
+        saved=saved_auto,
+        **common,
+    )
+
+
+def _automatic(
+    scene, folder, *, tol, resume, overwrite, saved, method, t_end, store_every, say, options, **common
+):
+    """The automatic run: pilots in memory, candidates streamed into ``folder``."""
+    from . import auto
+
+    t0 = time.perf_counter()
+    check_run_options(t_end, 0.01, store_every, common.get("checkpoint_every"))
+    folder = check_folder(folder, resume=resume, overwrite=overwrite)
+    method = scene.default_method if method is None else method
+    state = {"overwrite": overwrite}
+
+    def runner(*, level, tol_t, options, previous):
+        plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
+        res = _stream(
+            scene,
+            folder,
+            method=method,
+            t_end=t_end,
+            dt=None,
+            tol=tol_t,
+            resume=False,
+            overwrite=state["overwrite"],
+            store_every=store_every,
+            say=say,
+            options=options,
+            auto_plan=plan,
+            **common,
+        )
+        state["overwrite"] = True  # the next, finer candidate replaces this one
+        return res
+
+    if resume:
+        companion = auto.companion_from_record(saved["companion"])
+        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **options}
+        res = _stream(
+            scene,
+            folder,
+            method=method,
+            t_end=t_end,
+            dt=None,
+            tol=saved["tol_t"],
+            resume=True,
+            overwrite=False,
+            store_every=store_every,
+            say=say,
+            options=options,
+            auto_plan=saved,
+            **common,
+        )
+        res.info.update(level=saved["level"], tol_t=saved["tol_t"], elements=res.info.get("elements"))
+        ratio = saved["companion"]["level"] / saved["level"]
+        res.estimate = auto.estimate(res, companion, ratio)
+        res.info["auto"] = {"tol": saved["tol"], "resumed": True}
+    else:
+        say(f"femehl: automatic run to tol = {tol:g} (pilot runs in memory, then the run itself)")
+        try:
+            res = auto.solve_to_tolerance(
+                scene, t_end=t_end, tol=tol, method=method, store_every=store_every, runner=runner, **options
+            )
+        except SolverError as exc:
+            say(f"femehl: run stopped at t = {exc.t}: {exc}")
+            raise
+    _write_estimate(folder, res)
+    res.info["wall_s"] = time.perf_counter() - t0  # pilots and candidates
+    a = res.info.get("auto", {})
+    if "levels" in a:
+        say(
+            "femehl: chose "
+            + ", ".join(
+                f"level {lv:.3g}: {n} cells, {k} steps"
+                for lv, n, k in zip(a["levels"], a["elements"], a["steps"], strict=True)
+            )
+            + f"; estimated error {a.get('total', float('nan')):.2g} "
+            + ("(tol reached)" if a["reached"] else "(tol NOT reached)")
+        )
+    return res
+
+
+def _write_estimate(folder, res) -> None:
+    """The error columns of summary.csv and ``auto.json`` (what the automatic run chose)."""
+    import json
+
+    from .output.table import add_error_columns
+
+    if res.estimate is not None:
+        add_error_columns(folder / "summary.csv", res.estimate)
+    if "auto" in res.info:
+        info = {k: v for k, v in res.info["auto"].items()}
+        (folder / "auto.json").write_text(json.dumps(info, indent=1, default=float))
+
+
+def _stream(
+    scene,
+    folder,
+    *,
+    method,
+    t_end,
+    dt,
+    tol,
+    resume,
+    overwrite,
+    store_every,
+    progress,
+    say,
+    checkpoint_every,
+    options,
+    auto_plan=None,
+) -> Result:
+    """One run of one discretization, written into ``folder`` as it goes."""
     if tol is not None:
-        options.setdefault("scheme", "bdf2")
+        options = {"scheme": "bdf2", **options}
     step = 0.01 if dt is None else dt  # fixed steps; with tol only checked (None: the controller's)
     t_end, step, nsteps, store_every, every = check_run_options(t_end, step, store_every, checkpoint_every)
     dt = step if tol is None or dt is not None else None
-    resume, overwrite = check_resume_overwrite(resume, overwrite)
     progress = check_flag("progress", progress)
-    say = _reporter(log)
     folder = check_folder(folder, resume=resume, overwrite=overwrite)
     t0 = time.perf_counter()
     stepper = make_stepper(scene, method, **options)
     params = checkpoint.run_params(scene, stepper, step)
     params["tol"] = tol
+    if auto_plan is not None:
+        params["auto"] = auto_plan
     start = None
     if resume:
         checkpoint.check_params(checkpoint.read_params(folder), params)

@@ -181,6 +181,7 @@ KERNEL_ROUNDOFF = 64 * np.finfo(float).eps
 @settings(max_examples=150, deadline=None)
 @given(st.lists(st.floats(-2.0, 2.0, allow_nan=False), min_size=8, max_size=8))
 @example([1.876, 0.512, -1.961, -1.713, -1.872, -1.716, -1.708, -1.73])
+@example([0.0, 0.0, 0.0, 2.225073858507203e-309, 0.0, 1.0, 1.0, 0.0])  # A a subnormal off a vertex
 def test_triangle_influence_rearrangement_bounds(c):
     """area/max|A - x'| <= I(A, T) <= 2 sqrt(pi area), and I does not depend on orientation.
 

@@ -26,6 +26,7 @@ RUN_FILES = (
     "centreline.png",
     "fields.png",
     "line.png",
+    "auto.json",
 )
 _SERIES = re.compile(r"fields_\d+\.vtu$")
 _TEMPORARY = re.compile(r"(fields\.pvd|checkpoint\.npz|checkpoint\.json|fields_\d+\.vtu)\.tmp$")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import pathlib
 
-__all__ = ["COLUMNS", "SummaryWriter"]
+__all__ = ["COLUMNS", "ERROR_COLUMNS", "SummaryWriter", "add_error_columns"]
 
 COLUMNS = (
     "t",
@@ -80,4 +80,49 @@ def write_summary(result, path):
         w.writerow(COLUMNS)
         for i in range(len(s["t"])):
             w.writerow([f"{s[c][i]:.10g}" for c in COLUMNS])
+    return path
+
+
+#: the error-estimate columns added at the end of a run that has an estimate: for each
+#: headline quantity the estimated relative error (``err_<name>``) and its time part
+#: (``err_<name>_time``; the space part is the difference).  Empty where not estimated.
+ERROR_QUANTITIES = ("load", "film_center", "film_min")
+ERROR_COLUMNS = tuple(c for q in ERROR_QUANTITIES for c in (f"err_{q}", f"err_{q}_time"))
+
+
+def add_error_columns(path, estimate: dict) -> pathlib.Path:
+    """Rewrite the summary CSV at ``path`` with :data:`ERROR_COLUMNS` from ``estimate``.
+
+    ``estimate`` is a Result's (``{"t": ..., name: {"total", "space", "time"}}``); rows
+    at times outside its span (before a resumed run's start) get empty cells.  The new
+    file replaces the old one atomically.
+    """
+    import numpy as np
+
+    path = pathlib.Path(path)
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        return path
+    header = [c for c in rows[0] if c not in ERROR_COLUMNS]
+    keep = [i for i, c in enumerate(rows[0]) if c not in ERROR_COLUMNS]
+    ts = np.asarray(estimate["t"], dtype=float)
+    span = 1e-9 * max(1.0, abs(ts[-1]))
+
+    def cells(t):
+        out = []
+        for q in ERROR_QUANTITIES:
+            for part in ("total", "time"):
+                v = estimate[q][part]
+                inside = ts[0] - span <= t <= ts[-1] + span
+                out.append("" if v is None or not inside else f"{float(np.interp(t, ts, v)):.4g}")
+        return out
+
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header + list(ERROR_COLUMNS))
+        for row in rows[1:]:
+            w.writerow([row[i] for i in keep] + cells(float(row[0])))
+    tmp.replace(path)
     return path

@@ -100,6 +100,7 @@ def solve(
     tol: float | None = None,
     store_every: int = 1,
     callback: Callable[[State], None] | None = None,
+    estimate: bool = True,
     **options,
 ) -> Result:
     """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.result.Result`.
@@ -113,7 +114,10 @@ def solve(
       ``result.uncertainty(name, t)``;
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
       discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
-      ``tol`` is given (the result then carries the time part of the estimate).
+      ``tol`` is given.  The result carries the space part of the error estimate from a
+      companion run twice as coarse with the same steps (FE ladder rungs and ``"fitted"``,
+      line contact; about 10-25 % more work; ``estimate=False`` skips it) and, with
+      ``tol``, the time part (:func:`femehl.auto.expert_estimate`).
 
     Parameters
     ----------
@@ -139,6 +143,8 @@ def solve(
         Called with each State as it is produced (progress bars, writers); in automatic
         mode with the States of every run (``state.info`` has no level: use
         ``result.info["auto"]`` afterwards).
+    estimate : bool, default: True
+        Expert mode: also run the coarser companion for the space estimate.
     **options
         Options of the method (FD ``dr``, ``dtheta``; FE ``mesh``; line ``n_elements``)
         and of the stepper (``scheme``, ``linear_solver``, ``terms``, ...).
@@ -166,10 +172,12 @@ def solve(
         options.setdefault("scheme", "bdf2")
     stepper = make_stepper(scene, method, **options)
     result = run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
-    if tol is not None:
-        from .auto import time_estimate
+    from .auto import companion_run, expert_estimate
 
-        result.estimate = time_estimate(result)
+    companion, ratio = (
+        companion_run(scene, stepper.method, options, t_end, dt, tol, controls) if estimate else (None, None)
+    )
+    result.estimate = expert_estimate(result, companion, ratio, adaptive=tol is not None)
     return result
 
 

@@ -68,7 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.adaptive import LOAD_FLOOR, UNIT_STEP
-from .errors import SceneError
+from .errors import SceneError, SolverError
 from .result import Result
 
 __all__ = [
@@ -122,6 +122,9 @@ class Ladder:
     cells: Callable[..., float]
     #: the option names ``options`` sets (refused from the caller)
     keys: tuple[str, ...] = ()
+    #: ``companion(scene, options) -> (options, ratio) | None``: a coarser discretization
+    #: (sizes ``ratio`` times) of an expert's options, for the space estimate of an expert run
+    companion: Callable[..., tuple | None] | None = None
 
 
 #: method name -> its :class:`Ladder`
@@ -157,13 +160,38 @@ def _line_elements(level) -> int:
     return max(20, round(LINE_ELEMENTS / level))
 
 
-register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half")))
+def _fe_companion(scene, options):
+    from .discretizations.fe_disk import FITTED, _horizon
+    from .fe.fitted import fitted_disk
+    from .fe.mesh import LADDER, LADDER_RATIO
+
+    mesh = options.get("mesh", "medium")
+    if not isinstance(mesh, str):
+        return None
+    if mesh == FITTED:
+        coarse = fitted_disk(scene, _horizon(scene), level=2.0, half=options.get("half"))
+        return {**options, "mesh": coarse}, 2.0
+    names = list(LADDER)
+    if mesh not in names or names.index(mesh) == 0:
+        return None
+    k = names.index(mesh)
+    down = min(k, 2)
+    return {**options, "mesh": names[k - down]}, LADDER_RATIO**down
+
+
+def _line_companion(scene, options):
+    n = int(options.get("n_elements", LINE_ELEMENTS))
+    return ({**options, "n_elements": n // 2}, n / (n // 2)) if n >= 40 else None
+
+
+register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion))
 register_ladder(
     "line",
     Ladder(
         lambda scene, t_end, level: {"n_elements": _line_elements(level)},
         lambda scene, t_end, level: float(_line_elements(level)),
         ("n_elements",),
+        _line_companion,
     ),
 )
 
@@ -199,10 +227,53 @@ def time_error(res: Result) -> np.ndarray:
     return np.cumsum(local)
 
 
-def time_estimate(res: Result) -> dict:
-    """The time part of the estimate of an expert adaptive run (space and total None)."""
-    et = time_error(res)
-    return {"t": res.t, **{name: {"total": None, "space": None, "time": et.copy()} for name in QUANTITIES}}
+def companion_run(scene, method, options, t_end, dt, tol, controls) -> tuple:
+    """``(Result, ratio)`` of the coarser companion of an expert run, or ``(None, None)``.
+
+    Same time steps as the run (fixed ``dt``, or adaptive to the same ``tol``), the
+    method's :attr:`Ladder.companion` discretization.  A companion that stops (its
+    coarser mesh may not resolve the film) is logged and gives no space estimate.
+    """
+    from .api import make_stepper, run_loop
+    from .errors import SolverError
+
+    ladder = LADDERS.get(method)
+    plan = ladder.companion(scene, options) if ladder is not None and ladder.companion else None
+    if plan is None:
+        return None, None
+    coarse_options, ratio = plan
+    try:
+        coarse = make_stepper(scene, method, **coarse_options)
+        return run_loop(coarse, t_end, dt, tol=tol, store_every=0, **controls), ratio
+    except SolverError as exc:
+        logger.warning("femehl: no space estimate: the coarser companion run stopped (%s)", exc)
+        return None, None
+
+
+def expert_estimate(
+    res: Result, companion: Result | None, ratio: float | None, adaptive: bool
+) -> dict | None:
+    """The estimate of an expert run (its own mesh and steps).
+
+    ``space``: the running maximum of ``|q - q_c| / (ratio**2 - 1)`` against a
+    ``companion`` run ``ratio`` times coarser in space with the same time steps (fixed
+    ``dt``, or the same tolerance), so the difference is the space error; None without a
+    companion.  ``time``: the controller's accumulated local errors (:func:`time_error`)
+    for adaptive steps, None for fixed steps.  ``total = space + time`` when both are
+    known, else None.  None when neither is.
+    """
+    if companion is None and not adaptive:
+        return None
+    et = time_error(res) if adaptive else None
+    out = {"t": res.t}
+    for name in QUANTITIES:
+        space = None
+        if companion is not None:
+            space = np.maximum.accumulate(pair_error(res, companion, name, ratio))
+        tpart = None if et is None else et.copy()
+        total = space + tpart if space is not None and tpart is not None else None
+        out[name] = {"total": total, "space": space, "time": tpart}
+    return out
 
 
 def estimate(fine: Result, coarse: Result, ratio: float) -> dict:
@@ -345,15 +416,24 @@ def solve_to_tolerance(
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
     runs, est, reached, err = [], None, False, math.nan
-    fine = None
+    fine, failed = None, None
     while True:
         ne = ladder.cells(scene, t_end, level)
-        if runs and ne > max_elements:
+        if (runs or failed) and ne > max_elements:
             logger.info("auto: level %.3g would have ~%.0f cells > %d: stop", level, ne, max_elements)
+            if failed is not None and not runs:
+                raise failed  # no level within the budget got through
             break
         candidate = len(runs) >= MIN_RUNS - 1
         previous = runs[-1] if candidate else None
-        res = _run(scene, method, ladder, t_end, level, store_every, options, runner, previous)
+        try:
+            res = _run(scene, method, ladder, t_end, level, store_every, options, runner, previous)
+        except SolverError as exc:
+            if getattr(exc, "where", None) is None:
+                raise  # not a film that closes or a step floor: nothing a finer mesh changes
+            failed = _closing_confirmed(failed, exc, level, t_end)
+            level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
+            continue
         if runs:
             ratio = runs[-1].info["level"] / level
             est = estimate(res, runs[-1], ratio)
@@ -368,6 +448,44 @@ def solve_to_tolerance(
             break
         level = _next_level(level, err, tol) if len(runs) >= 2 else level / 2.0
     return _finish(fine, est, runs, tol, reached)
+
+
+#: two runs whose films close within this fraction of t_end of each other, and within
+#: CLOSE_DISTANCE of each other in space, confirm that the film really closes
+CLOSE_TIME, CLOSE_DISTANCE = 0.05, 0.2
+#: ... if the finer one's film fell steadily to zero, or below this fraction of the initial film
+CLOSED_FILM = 1e-3
+
+
+def _closing_confirmed(earlier, exc, level, t_end):
+    """Raise ``exc`` if a coarser run closed its film at about the same time and place.
+
+    A film that closes on one mesh may only be unresolved there (a coarse pilot at a
+    thin exit); the next level, twice as fine, decides.  The closing is confirmed when
+    this run's film really closes (``reason == "closes"``: it fell steadily to zero; or
+    the step floor was reached with the film below CLOSED_FILM times the initial film),
+    at a level <= 1 (not a pilot), within CLOSE_TIME * t_end and CLOSE_DISTANCE of the
+    previous failure.  Returns ``exc`` (with the level recorded)
+    to remember for that comparison.
+    """
+    exc.level = level
+    logger.info(
+        "auto: the film closed at level %.3g (t = %.4g at %s): trying a finer mesh", level, exc.t, exc.where
+    )
+    d_min, film0 = getattr(exc, "d_min", math.nan), getattr(exc, "film0", math.nan)
+    closed = getattr(exc, "reason", "closes") == "closes" or d_min <= CLOSED_FILM * film0
+    if earlier is not None and closed and level <= 1.0:
+        dt = abs(float(exc.t) - float(earlier.t))
+        dx = float(np.hypot(*(np.asarray(exc.where, float) - np.asarray(earlier.where, float))))
+        if dt <= CLOSE_TIME * t_end and dx <= CLOSE_DISTANCE:
+            exc.args = (
+                f"{exc.args[0]} The film closed at about the same time and place on two meshes "
+                f"(levels {earlier.level:.3g} and {level:.3g}), the finer one to {d_min:.3g} "
+                f"({d_min / film0:.2g} of the initial film): it really closes.",
+                *exc.args[1:],
+            )
+            raise exc
+    return exc
 
 
 def _finish(res: Result, est, runs, tol, reached) -> Result:

@@ -78,7 +78,9 @@ def _parser():
         help="replace the run already in the output folder (its femehl files only)",
     )
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
-    b.add_argument("what", choices=["accuracy", "stress", "fitted_mesh", "auto"], help="which study")
+    b.add_argument(
+        "what", choices=["accuracy", "stress", "stress_auto", "fitted_mesh", "auto"], help="which study"
+    )
     b.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
@@ -218,7 +220,8 @@ def _with_error(res, name: str, t: float) -> str:
     u = res.uncertainty(name, t)
     if u["total"] is not None:
         return f"{v} (+-{100 * u['total']:.2g} %)"
-    return f"{v} (time part +-{100 * u['time']:.2g} %)"
+    part = "space" if u["space"] is not None else "time"
+    return f"{v} ({part} part +-{100 * u[part]:.2g} %)"
 
 
 class _SummaryFile:

@@ -164,7 +164,10 @@ def run_to_folder(
     if resume:
         saved_auto = checkpoint.read_params(check_folder(folder, resume=True)).get("auto")
     if saved_auto is None and not is_automatic(scene, method, dt, options):
-        return _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
+        res = _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
+        if not resume:  # the space estimate from the coarser companion (a resumed run: its part only)
+            _expert_estimate(scene, pathlib.Path(folder), res, dt, tol, options, t_end, say)
+        return res
     if dt is not None:
         raise SceneError("an automatic run chooses its time steps: leave dt out (or give the mesh too).")
     return _automatic(
@@ -192,23 +195,24 @@ def _automatic(
 
     def runner(*, level, tol_t, options, previous):
         plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
-        res = _stream(
-            scene,
-            folder,
-            method=method,
-            t_end=t_end,
-            dt=None,
-            tol=tol_t,
-            resume=False,
-            overwrite=state["overwrite"],
-            store_every=store_every,
-            say=say,
-            options=options,
-            auto_plan=plan,
-            **common,
-        )
-        state["overwrite"] = True  # the next, finer candidate replaces this one
-        return res
+        try:
+            return _stream(
+                scene,
+                folder,
+                method=method,
+                t_end=t_end,
+                dt=None,
+                tol=tol_t,
+                resume=False,
+                overwrite=state["overwrite"],
+                store_every=store_every,
+                say=say,
+                options=options,
+                auto_plan=plan,
+                **common,
+            )
+        finally:
+            state["overwrite"] = True  # the next, finer candidate replaces this one
 
     if resume:
         companion = auto.companion_from_record(saved["companion"])
@@ -255,6 +259,20 @@ def _automatic(
             + ("(tol reached)" if a["reached"] else "(tol NOT reached)")
         )
     return res
+
+
+def _expert_estimate(scene, folder, res, dt, tol, options, t_end, say) -> None:
+    """An expert run's estimate (:func:`femehl.auto.expert_estimate`) into summary.csv."""
+    from .auto import companion_run, expert_estimate
+
+    options = {"scheme": "bdf2", **options} if tol is not None else dict(options)
+    step = (0.01 if dt is None else dt) if tol is None else dt
+    companion, ratio = companion_run(scene, res.method, options, t_end, step, tol, {})
+    res.estimate = expert_estimate(res, companion, ratio, adaptive=tol is not None)
+    if res.estimate is not None:
+        _write_estimate(folder, res)
+        if companion is not None:
+            say(f"femehl: space estimate from a companion run {ratio:.3g} times coarser")
 
 
 def _write_estimate(folder, res) -> None:

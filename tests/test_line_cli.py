@@ -12,7 +12,7 @@ from femehl.api import solve_line
 from femehl.cli import main
 from femehl.errors import SceneFileError
 from femehl.line import LineScene
-from femehl.output.table import COLUMNS
+from femehl.output.table import COLUMNS, ERROR_COLUMNS
 from femehl.scene import Motion, RampHold, TanhStart
 from femehl.scenefile import load_scene_file
 
@@ -43,8 +43,10 @@ def test_cli_runs_line_contact(tmp_path, capsys):
     assert (out / "fields.pvd").is_file() and (out / "checkpoint.npz").is_file()  # a run folder
     with open(out / "summary.csv", newline="") as fh:
         rows = list(csv.reader(fh))
-    assert tuple(rows[0]) == COLUMNS
-    data = np.array(rows[1:], dtype=float)
+    # the expert run's space estimate (a companion on 200 elements) is appended at the end
+    assert tuple(rows[0]) == COLUMNS + ERROR_COLUMNS
+    assert all(r[len(COLUMNS) + 1] for r in rows[1:])  # err_load_space is filled
+    data = np.array([r[: len(COLUMNS)] for r in rows[1:]], dtype=float)
     ref = solve_line(load_scene_file(TOML)[0], 2.0, 0.05, n_elements=400)
     assert data.shape[0] == ref.info["steps"] + 1 == 41
     col = {c: data[:, i] for i, c in enumerate(COLUMNS)}

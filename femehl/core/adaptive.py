@@ -330,6 +330,7 @@ def _floor_error(
             d_min=float(d),
         )
         exc.reason = "closes"
+        exc.film0 = float(run.film0)
         return exc
     msg = (
         f"adaptive step floor reached at t = {last.t:.6g}: {what}, and the next retry would "
@@ -342,6 +343,7 @@ def _floor_error(
     else:
         exc = FilmRuptureError(msg, t=last.t, where=(x, y), d_min=float(d))
     exc.reason = "step floor"
+    exc.where, exc.d_min, exc.film0 = (x, y), float(d), float(run.film0)  # for femehl.auto
     return exc
 
 

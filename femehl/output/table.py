@@ -84,10 +84,10 @@ def write_summary(result, path):
 
 
 #: the error-estimate columns added at the end of a run that has an estimate: for each
-#: headline quantity the estimated relative error (``err_<name>``) and its time part
-#: (``err_<name>_time``; the space part is the difference).  Empty where not estimated.
+#: headline quantity the estimated relative error (``err_<name>``) and its space and time
+#: parts (``err_<name>_space``, ``err_<name>_time``).  Empty where not estimated.
 ERROR_QUANTITIES = ("load", "film_center", "film_min")
-ERROR_COLUMNS = tuple(c for q in ERROR_QUANTITIES for c in (f"err_{q}", f"err_{q}_time"))
+ERROR_COLUMNS = tuple(c for q in ERROR_QUANTITIES for c in (f"err_{q}", f"err_{q}_space", f"err_{q}_time"))
 
 
 def add_error_columns(path, estimate: dict) -> pathlib.Path:
@@ -112,7 +112,7 @@ def add_error_columns(path, estimate: dict) -> pathlib.Path:
     def cells(t):
         out = []
         for q in ERROR_QUANTITIES:
-            for part in ("total", "time"):
+            for part in ("total", "space", "time"):
                 v = estimate[q][part]
                 inside = ts[0] - span <= t <= ts[-1] + span
                 out.append("" if v is None or not inside else f"{float(np.interp(t, ts, v)):.4g}")

@@ -114,6 +114,7 @@ def main(argv=None) -> None:
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--cap", type=float, default=300.0, help="wall-time cap per case, seconds")
     ap.add_argument("--only-beta", help="comma-separated beta values")
+    ap.add_argument("--cases", help='semicolon-separated "beta,h0,T" triples (instead of the whole matrix)')
     ap.add_argument("--resume", action="store_true")
     args = ap.parse_args(argv)
     if args.worker:
@@ -124,7 +125,10 @@ def main(argv=None) -> None:
     if not args.resume:
         RUNS.write_text("")
     done = {(r["beta"], r["h0"], r["T"]) for r in records}
-    for beta, h0, T in itertools.product(betas, H0S, TS):
+    cases = list(itertools.product(betas, H0S, TS))
+    if args.cases:
+        cases = [tuple(float(v) for v in c.split(",")) for c in args.cases.split(";")]
+    for beta, h0, T in cases:
         if (beta, h0, T) in done:
             continue
         rec = run_case(dict(beta=beta, h0=h0, T=T), args.cap)

@@ -217,3 +217,33 @@ def test_automatic_run_resumes(tmp_path):
     more = run_to_folder(scene, out, t_end=0.8, resume=True)
     assert more.info["level"] == level and more.t[-1] == pytest.approx(0.8)
     assert more.uncertainty("film_min", 0.8)["total"] is not None
+
+
+# ---- a film that closes ------------------------------------------------------------------
+def _closed(t, where, reason="closes", d_min=0.0, film0=0.1):
+    exc = femehl.FilmRuptureError("the film closes.", t=t, where=where, d_min=d_min)
+    exc.reason, exc.film0 = reason, film0
+    return exc
+
+
+def test_a_closing_on_a_pilot_is_retried_finer():
+    """Level 2 (a pilot) closes: not confirmed, the next level decides."""
+    from femehl.auto import _closing_confirmed
+
+    first = _closing_confirmed(None, _closed(1.70, (-0.74, 0.0)), 2.0, 3.0)
+    assert first.level == 2.0
+    # level 1 closes at another place and time: the coarse closing was the mesh's
+    second = _closing_confirmed(first, _closed(2.31, (-1.22, 0.13)), 1.0, 3.0)
+    assert second.level == 1.0
+
+
+def test_a_closing_confirmed_by_two_levels_is_raised():
+    from femehl.auto import _closing_confirmed
+
+    earlier = _closing_confirmed(None, _closed(2.312, (-1.217, 0.129)), 1.0, 3.0)
+    # a step floor with the film at 9e-6 of h0 = 0.01 (9e-4 of it) at the same place: closed
+    with pytest.raises(femehl.FilmRuptureError, match="really closes"):
+        _closing_confirmed(earlier, _closed(2.312, (-1.22, 0.129), "step floor", 9.1e-6, 0.01), 0.5, 3.0)
+    # a step floor with a film that is not thin: not confirmed, refine on
+    again = _closing_confirmed(earlier, _closed(2.312, (-1.22, 0.129), "step floor", 5e-3, 0.01), 0.5, 3.0)
+    assert again.level == 0.5

@@ -349,7 +349,9 @@ def _floor_error(
 
 def _limits(t_span, tol, dt0, dt_min, dt_max):
     dt_max = t_span / 10.0 if dt_max is None else check_positive("dt_max", dt_max)
-    dt_min = 1e-6 * t_span if dt_min is None else check_positive("dt_min", dt_min)
+    # the floor stays 100 times below the first step (a long run at a small tol starts
+    # with steps ~0.05 tol, below 1e-6 of its span)
+    dt_min = min(1e-6 * t_span, 5e-4 * tol) if dt_min is None else check_positive("dt_min", dt_min)
     if dt0 is None:
         dt0 = max(dt_min, min(dt_max, 0.05 * tol))
     dt0 = check_positive("dt0", dt0)
@@ -384,7 +386,8 @@ def march_adaptive(
     dt0 : float, optional
         First step and the step after each breakpoint; default ``0.05 tol``.
     dt_min, dt_max : float, optional
-        Step floor and ceiling; default ``1e-6`` and ``0.1`` times the run's span.
+        Step floor and ceiling; default ``min(1e-6 span, 5e-4 tol)`` (100 times below
+        the default first step) and ``0.1`` times the run's span.
     start : State, optional
         Continue from this state (its history is dropped: the run restarts there).
     safety : float, default: 0.9

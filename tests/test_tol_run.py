@@ -46,3 +46,15 @@ def test_scene_file_run_tol(tmp_path):
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 0
     t = _times(out)
     assert t[-1] == 0.5 and np.ptp(np.diff(t)) > 0
+
+
+def test_scene_file_tol_without_a_mesh_is_automatic(tmp_path):
+    """``[run] tol`` and no mesh/dt: the file's tol is the accuracy of an automatic run."""
+    import json
+
+    path = tmp_path / "s.toml"
+    path.write_text("[fluid]\nbeta = 200.0\n[run]\ntol = 0.05\nt_end = 0.2\n")
+    out = tmp_path / "o"
+    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 0
+    chosen = json.loads((out / "auto.json").read_text())
+    assert chosen["tol"] == 0.05 and chosen["reached"] and chosen["total"] <= 0.05

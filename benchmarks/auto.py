@@ -191,6 +191,8 @@ def _status(r: dict) -> str:
 
 def cheapest(hand: list, r: dict, ref, limit: float) -> str:
     """The cheapest hand-tuned run of ``r``'s scene whose worst true error is <= ``limit``."""
+    if not any(h["scene"] == r["scene"] for h in hand):
+        return "grid not run"
     ok = []
     for h in hand:
         if h["scene"] != r["scene"] or not ref:
@@ -318,15 +320,15 @@ def _plot(points) -> None:
     fig, ax = plt.subplots(figsize=(5.5, 5))
     marks = {"load": "o", "film_center": "s", "film_min": "^"}
     for tol, q, est, true, _ in points:
-        ax.scatter(max(true, 1e-6), max(est, 1e-6), marker=marks[q], c="C0" if tol >= 1e-2 else "C1", s=25)
-    lim = (1e-6, 1e-1)
+        ax.scatter(max(true, 1e-4), max(est, 1e-4), marker=marks[q], c="C0" if tol >= 1e-2 else "C1", s=25)
+    lim = (1e-4, 1e-1)
     ax.plot(lim, lim, "k-", lw=0.8, label="estimate = true")
     ax.plot(lim, [v / 2 for v in lim], "k--", lw=0.8, label="estimate = true / 2")
     for tol in sorted({p[0] for p in points}):
         ax.axvline(tol, color="C0" if tol >= 1e-2 else "C1", lw=0.8, ls=":", label=f"tol = {tol:g}")
     ax.set(xscale="log", yscale="log", xlim=lim, ylim=lim, xlabel="true error (max over t)")
     ax.set_ylabel("estimated error (max over t)")
-    ax.set_title("femehl automatic accuracy: o load, s central, ^ minimum film")
+    ax.set_title("automatic runs: o load, s central film, ^ minimum film", fontsize=9)
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     fig.savefig(HERE / "auto_results.png", dpi=110)

@@ -191,10 +191,12 @@ def _automatic(
     check_run_options(t_end, 0.01, store_every, common.get("checkpoint_every"))
     folder = check_folder(folder, resume=resume, overwrite=overwrite)
     method = scene.default_method if method is None else method
-    state = {"overwrite": overwrite}
+    state = {"overwrite": overwrite, "replaces": False}
 
     def runner(*, level, tol_t, options, previous):
         plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
+        if state["replaces"]:
+            plan["replaces"] = True
         try:
             return _stream(
                 scene,
@@ -212,7 +214,7 @@ def _automatic(
                 **common,
             )
         finally:
-            state["overwrite"] = True  # the next, finer candidate replaces this one
+            state["overwrite"] = state["replaces"] = True  # the next, finer candidate replaces this one
 
     if resume:
         companion = auto.companion_from_record(saved["companion"])
@@ -275,6 +277,11 @@ def _expert_estimate(scene, folder, res, dt, tol, options, t_end, say) -> None:
             say(f"femehl: space estimate from a companion run {ratio:.3g} times coarser")
 
 
+def state_replaces(plan: dict) -> bool:
+    """True for an automatic candidate that replaces a coarser candidate of the same run."""
+    return bool(plan.get("replaces"))
+
+
 def _write_estimate(folder, res) -> None:
     """The error columns of summary.csv and ``auto.json`` (what the automatic run chose)."""
     import json
@@ -329,7 +336,13 @@ def _stream(
     # ---- everything is checked: from here on the folder is written ----
     removed = prepare_folder(folder, overwrite=overwrite)
     if removed:
-        say(f"femehl: overwrite: removed {len(removed)} file(s) of the earlier run in {folder}")
+        if auto_plan is not None and state_replaces(auto_plan):
+            say(
+                f"femehl: automatic: this finer run replaces the coarser one's {len(removed)} "
+                f"file(s) in {folder}"
+            )
+        else:
+            say(f"femehl: overwrite: removed {len(removed)} file(s) of the earlier run in {folder}")
     if resume:
         say(f"femehl: resuming from the checkpoint at t = {start.t:g} (step {start.step})")
         if t_end <= start.t + 1e-9 * max(1.0, start.t):

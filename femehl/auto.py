@@ -294,7 +294,7 @@ def estimate(fine: Result, coarse: Result, ratio: float) -> dict:
     return out
 
 
-class _Series:
+class CompanionSeries:
     """The headline series of a run, as saved in a run folder (``auto.json``): ``value_at``."""
 
     def __init__(self, record: dict):
@@ -313,10 +313,6 @@ def companion_record(res) -> dict:
         "t": res.t.tolist(),
         **{q: getattr(res, q).tolist() for q in QUANTITIES},
     }
-
-
-def companion_from_record(record: dict) -> _Series:
-    return _Series(record)
 
 
 def _worst(est: dict, part: str = "total") -> float:
@@ -344,7 +340,10 @@ def _run(scene, method, ladder, t_end, level, store_every, options, runner=None,
     if runner is not None and previous is not None:
         res = runner(level=level, tol_t=tol_t, options=disc, previous=previous)
     else:
-        res = _adaptive(scene, method, t_end, tol_t, store_every, disc)
+        from .api import solve
+
+        # the expert path with this level's discretization; the estimate is the pair's
+        res = solve(scene, method, t_end=t_end, tol=tol_t, store_every=store_every, estimate=False, **disc)
     n = int(res.info.get("elements", ladder.cells(scene, t_end, level)))
     res.info.update(level=level, elements=n, tol_t=tol_t, wall=time.perf_counter() - t0)
     logger.info(
@@ -356,18 +355,6 @@ def _run(scene, method, ladder, t_end, level, store_every, options, runner=None,
         res.info["wall"],
     )
     return res
-
-
-def _adaptive(scene, method, t_end, tol_t, store_every, options) -> Result:
-    from .api import make_stepper, run_loop
-    from .core.adaptive import CONTROLS
-
-    options = dict(options)
-    callback = options.pop("callback", None)
-    controls = {k: options.pop(k) for k in CONTROLS if k in options}
-    options.setdefault("scheme", "bdf2")
-    stepper = make_stepper(scene, method, **options)
-    return run_loop(stepper, t_end, tol=tol_t, store_every=store_every, on_state=callback, **controls)
 
 
 def _next_level(level: float, err: float, tol: float) -> float:
@@ -412,7 +399,7 @@ def solve_to_tolerance(
     if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
         raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
     ladder = LADDERS[method]
-    for key in ("tol", "dt_max", "dt", *ladder.keys):
+    for key in ("dt_max", "dt", *ladder.keys):
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
     runs, est, reached, err = [], None, False, math.nan

@@ -191,50 +191,40 @@ def _automatic(
     check_run_options(t_end, 0.01, store_every, common.get("checkpoint_every"))
     folder = check_folder(folder, resume=resume, overwrite=overwrite)
     method = scene.default_method if method is None else method
-    state = {"overwrite": overwrite, "replaces": False}
+    first = {"candidate": True}
 
-    def runner(*, level, tol_t, options, previous):
-        plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
-        if state["replaces"]:
-            plan["replaces"] = True
-        try:
-            return _stream(
-                scene,
-                folder,
-                method=method,
-                t_end=t_end,
-                dt=None,
-                tol=tol_t,
-                resume=False,
-                overwrite=state["overwrite"],
-                store_every=store_every,
-                say=say,
-                options=options,
-                auto_plan=plan,
-                **common,
-            )
-        finally:
-            state["overwrite"] = state["replaces"] = True  # the next, finer candidate replaces this one
-
-    if resume:
-        companion = auto.companion_from_record(saved["companion"])
-        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **options}
-        res = _stream(
+    def stream(options, plan, *, resume=False):
+        """One run of the automatic sequence streamed into ``folder`` (``plan``: its level)."""
+        return _stream(
             scene,
             folder,
             method=method,
             t_end=t_end,
             dt=None,
-            tol=saved["tol_t"],
-            resume=True,
-            overwrite=False,
+            tol=plan["tol_t"],
+            resume=resume,
+            overwrite=overwrite if first["candidate"] or resume else True,
             store_every=store_every,
             say=say,
             options=options,
-            auto_plan=saved,
+            auto_plan=plan,
             **common,
         )
-        res.info.update(level=saved["level"], tol_t=saved["tol_t"], elements=res.info.get("elements"))
+
+    def runner(*, level, tol_t, options, previous):
+        plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
+        if not first["candidate"]:
+            plan["replaces"] = True  # a finer candidate replaces the coarser one's files
+        try:
+            return stream(options, plan)
+        finally:
+            first["candidate"] = False
+
+    if resume:
+        companion = auto.CompanionSeries(saved["companion"])
+        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **options}
+        res = stream(options, saved, resume=True)
+        res.info.update(level=saved["level"], tol_t=saved["tol_t"])
         ratio = saved["companion"]["level"] / saved["level"]
         res.estimate = auto.estimate(res, companion, ratio)
         res.info["auto"] = {"tol": saved["tol"], "resumed": True}
@@ -275,11 +265,6 @@ def _expert_estimate(scene, folder, res, dt, tol, options, t_end, say) -> None:
         _write_estimate(folder, res)
         if companion is not None:
             say(f"femehl: space estimate from a companion run {ratio:.3g} times coarser")
-
-
-def state_replaces(plan: dict) -> bool:
-    """True for an automatic candidate that replaces a coarser candidate of the same run."""
-    return bool(plan.get("replaces"))
 
 
 def _write_estimate(folder, res) -> None:
@@ -336,7 +321,7 @@ def _stream(
     # ---- everything is checked: from here on the folder is written ----
     removed = prepare_folder(folder, overwrite=overwrite)
     if removed:
-        if auto_plan is not None and state_replaces(auto_plan):
+        if auto_plan is not None and auto_plan.get("replaces"):
             say(
                 f"femehl: automatic: this finer run replaces the coarser one's {len(removed)} "
                 f"file(s) in {folder}"

@@ -77,8 +77,11 @@ DEFAULT_TOL = 1e-2
 
 
 def discretization_options(method: str) -> set[str]:
-    """The option names of ``method``'s discretization (its constructor's parameters)."""
-    return set(inspect.signature(_registry()[method]).parameters) - {"scene"}
+    """The option names that choose ``method``'s discretization (its constructor's
+    parameters, less those that only choose how its operators are computed, such as FE's
+    ``operator``: those keep a run automatic)."""
+    cls = _registry()[method]
+    return set(inspect.signature(cls).parameters) - {"scene"} - set(getattr(cls, "operator_options", ()))
 
 
 def is_automatic(scene, method: str | None, dt, options) -> bool:

@@ -48,6 +48,11 @@ def _parser():
         "--mesh",
         help="FE mesh: coarse|medium|fine|xfine|fitted or a mesh file (default: chosen from --tol)",
     )
+    r.add_argument(
+        "--operator",
+        choices=["auto", "dense", "fast"],
+        help="FE elastic operator: dense, fast (hierarchical, for large meshes) or auto (default: by size)",
+    )
     r.add_argument("--dr", type=float, help="FD radial step (default 0.0125)")
     r.add_argument("--dtheta-divisions", type=int, help="FD: dtheta = pi/N (default 36)")
     r.add_argument(
@@ -79,7 +84,9 @@ def _parser():
     )
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument(
-        "what", choices=["accuracy", "stress", "stress_auto", "fitted_mesh", "auto"], help="which study"
+        "what",
+        choices=["accuracy", "stress", "stress_auto", "fitted_mesh", "auto", "fast_operator"],
+        help="which study",
     )
     b.add_argument("rest", nargs=argparse.REMAINDER)
     return p
@@ -148,7 +155,7 @@ def _run(args, argv=()):
         )
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
-    for key in ("scheme", "mesh", "n_elements", "dt", "tol", "t_end", "store_every"):
+    for key in ("scheme", "mesh", "operator", "n_elements", "dt", "tol", "t_end", "store_every"):
         v = getattr(args, key)
         if v is not None and not (key == "scheme" and method == "fd"):  # fd: euler, its own scheme
             run[key] = v

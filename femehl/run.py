@@ -69,7 +69,9 @@ def _terms(scene, stepper, t_end: float) -> str:
         f"sliding={eff['sliding']}, elasticity={eff['elasticity']}, "
         f"imposed_load={eff['imposed_load']}; "
         + ", ".join(
-            f"{k}={v}" for k, v in info.items() if k in ("mesh", "elements", "nodes", "unknowns", "half")
+            f"{k}={v}"
+            for k, v in info.items()
+            if k in ("mesh", "elements", "nodes", "unknowns", "half", "operator")
         )
     )
 

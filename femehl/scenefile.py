@@ -17,7 +17,8 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           table as above; hc(t) is then solved for and
                           [motion.gap] gives only hc(0)
     [domain]              L = 2.0
-    [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions
+    [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions,
+                          tol, operator ("auto" | "dense" | "fast"), operator_tol
 
 Line contact (a rigid cylinder, gap x^2/2, on a Winkler foundation; see
 :mod:`femehl.line`): ``[indenter] kind = "cylinder"`` needs ``[substrate]
@@ -91,6 +92,8 @@ RUN_KEYS = {
     "dtheta_divisions",
     "linear_solver",
     "tol",
+    "operator",
+    "operator_tol",
 }
 #: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
 LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading", "tol"}

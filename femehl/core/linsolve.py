@@ -26,7 +26,12 @@ Solvers are registered in :data:`LINEAR_SOLVERS` by name:
     of the last solve cost more than the average cost per solve since the last
     factorization (factorization included), or when ``c_0 = a0/dt`` changed by more than
     10 %.  ``refactor_after=n`` instead refreshes when a solve needed more than ``n``
-    preconditioned iterations.  ``rtol`` is the relative residual ``||b - A x|| / ||b||``
+    preconditioned iterations.  With the *fast* operator (:mod:`femehl.hmatrix`, ``C``
+    never formed) the products ``C z`` are hierarchical and the preconditioner is the
+    sparse LU (SuperLU) of ``D + G C_near``, ``C_near`` the exact near field within a
+    few element sizes (:attr:`femehl.hmatrix.FastCompliance.preconditioner`); there is
+    no direct fallback (a solve that does not converge raises).  ``rtol`` is the relative
+    residual ``||b - A x|| / ||b||``
     (default 1e-8: over the whole paper case that moves the films by < 4e-6 relative to a
     direct solve, three orders below the finest discretization error).  With a sparse
     ``C`` (Winkler, rigid) there is no dense product to save and it solves directly.
@@ -67,7 +72,8 @@ class StepOperator:
     D : sparse matrix (n, n)
         The part acting on the unknowns directly.
     films : list of (coefficient, F, FC)
-        Film operators ``F`` (sparse, n x film points) with their fixed products ``F C``.
+        Film operators ``F`` (sparse, n x film points) with their fixed products ``F C``
+        (for a fast ``C``: the sparse near-field product, used by the preconditioner only).
     C : ndarray or sparse matrix (film points, n)
         Compliance: ``d = h + C p`` on the film points.
     key : float
@@ -83,6 +89,18 @@ class StepOperator:
     def dense(self) -> bool:
         return isinstance(self.C, np.ndarray)
 
+    @property
+    def fast(self) -> bool:
+        """``C`` is a hierarchical operator: products only, ``matrix()`` does not exist."""
+        return bool(getattr(self.C, "is_fast", False))
+
+    def near_matrix(self):
+        """Sparse CSC ``D + sum_i c_i F_i C_near`` of a fast operator: the preconditioner."""
+        A = self.D
+        for c, _, FC in self.films:
+            A = A + c * FC
+        return sp.csc_matrix(A)
+
     @cached_property
     def G(self):
         """``sum_i c_i F_i`` (sparse, n x film points), formed once per step."""
@@ -95,6 +113,11 @@ class StepOperator:
 
     def matrix(self, dtype=np.float64):
         """The whole ``A``: dense, formed in place (row blocks, C-ordered), or sparse CSC."""
+        if self.fast:
+            raise SceneError(
+                "the fast elastic operator is never formed, so this system has no matrix for a "
+                "direct solve: use linear_solver='gmres' (the default) or operator='dense'."
+            )
         if not self.dense:
             A = self.D
             for c, _, FC in self.films:
@@ -228,12 +251,18 @@ class RecycledGCR:
         default (None): by cost balancing.
     recycle : int, default: 8
         Recycled directions kept between solves (0: none).
-    max_krylov : int, default: 30
-        Preconditioned iterations before falling back to a direct solve.
+    max_krylov : int, optional
+        Preconditioned iterations before falling back to a direct solve; default 30, and
+        200 with the fast operator (its sparse preconditioner needs more, and there is
+        no direct solve to fall back to).
     """
 
     def __init__(
-        self, rtol: float = 1e-8, refactor_after: int | None = None, recycle: int = 8, max_krylov: int = 30
+        self,
+        rtol: float = 1e-8,
+        refactor_after: int | None = None,
+        recycle: int = 8,
+        max_krylov: int | None = None,
     ):
         try:
             rtol = float(rtol)
@@ -247,6 +276,10 @@ class RecycledGCR:
             raise SceneError(f"refactor_after must be an integer >= 1 or None, got {refactor_after!r}.")
         if isinstance(recycle, bool) or not isinstance(recycle, int) or recycle < 0:
             raise SceneError(f"recycle must be an integer >= 0, got {recycle!r}.")
+        if max_krylov is not None and (
+            isinstance(max_krylov, bool) or not isinstance(max_krylov, int) or max_krylov < 1
+        ):
+            raise SceneError(f"max_krylov must be an integer >= 1 or None, got {max_krylov!r}.")
         self.rtol = rtol
         self.refactor_after = refactor_after
         self.recycle = recycle
@@ -264,7 +297,7 @@ class RecycledGCR:
 
     def solve(self, op: StepOperator, rhs: list, t: float) -> list:
         self.residuals = []
-        if not op.dense:  # nothing dense to save: solve directly
+        if not (op.dense or op.fast):  # nothing dense to save: solve directly
             out = self.direct.solve(op, rhs, t)
             self.residuals = self.direct.residuals
             self._sync()
@@ -289,6 +322,14 @@ class RecycledGCR:
         self.info["krylov_iterations"] += its
         self.info["krylov_s"] += time.perf_counter() - t0
         if x is None:
+            if fresh and op.fast:
+                raise SingularSystemError(
+                    f"step at t = {t:.6g}: the Krylov solve with the fast elastic operator did not "
+                    f"reach rtol = {self.rtol:g} in {self._max_its(op)} iterations even with a fresh "
+                    "preconditioner. Try a smaller dt, max_krylov larger, or operator='dense' if the "
+                    "mesh fits.",
+                    t=t,
+                )
             if fresh:  # even a fresh preconditioner failed: solve directly in double
                 x = self.direct.solve(op, [b], t)[0][0]
                 self._sync()
@@ -305,11 +346,17 @@ class RecycledGCR:
             f.stale = marginal > f.total / f.solves
         return x, Cx
 
+    def _max_its(self, op):
+        if self.max_krylov is not None:
+            return self.max_krylov
+        return 200 if op.fast else 30
+
     def _refactor(self, op, t):
-        """Single-precision LU of the current A, the preconditioner (in place)."""
+        """The preconditioner: single-precision LU of the current A, or with the fast
+        operator the sparse LU of its near-field part."""
         self.factor = None  # free the old factor before forming the new A
         t0 = time.perf_counter()
-        lu = _dense_lu(op.matrix(dtype=self.precond_dtype), t)
+        lu = _sparse_lu(op.near_matrix(), t) if op.fast else _dense_lu(op.matrix(dtype=self.precond_dtype), t)
         cost = time.perf_counter() - t0
         self._own_factorizations += 1
         self._own_factor_s += cost
@@ -319,6 +366,8 @@ class RecycledGCR:
 
     def _precondition(self, r):
         lu = self.factor.lu
+        if isinstance(lu, spla.SuperLU):
+            return lu.solve(r)
         return sla.lu_solve(lu, r.astype(lu[0].dtype, copy=False), trans=1, check_finite=False).astype(
             np.float64, copy=False
         )
@@ -332,7 +381,8 @@ class RecycledGCR:
         C, D = op.C, op.D
         tol = self.rtol * bnorm
         rec = self.solutions + self.directions
-        m = len(rec) + self.max_krylov
+        max_its = self._max_its(op)
+        m = len(rec) + max_its
         n, ne = b.size, C.shape[0]
         Z = np.empty((m, n))  # row j: direction z_j
         CZ = np.empty((m, ne))  # row j: C z_j
@@ -363,7 +413,7 @@ class RecycledGCR:
         k_rec = k
         hist = [float(np.linalg.norm(r)) / bnorm]
         while True:
-            if hist[-1] <= 0.5 * self.rtol or its >= self.max_krylov:
+            if hist[-1] <= 0.5 * self.rtol or its >= max_its:
                 if k == 0:
                     return None, None, its, []
                 y = sla.solve_triangular(R[:k, :k], g[:k])
@@ -376,12 +426,12 @@ class RecycledGCR:
                 if np.isfinite(res) and res <= tol:
                     self.residuals.append(res / bnorm)
                     return x, Cx, its, [(Z[j].copy(), CZ[j].copy()) for j in range(k_rec, k)]
-                if its >= self.max_krylov or not np.isfinite(res):
+                if its >= max_its or not np.isfinite(res):
                     return None, None, its, []
                 r = rt - (Q[:k] @ rt) @ Q[:k]  # continue from the true residual
             t0 = time.perf_counter()
             z = self._precondition(r)
-            cz = C @ z  # the one dense product
+            cz = C @ z  # the one dense (or hierarchical) product
             q = D @ z + G @ cz
             h = np.zeros(k)
             for _ in range(2):

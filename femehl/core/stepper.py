@@ -44,8 +44,8 @@ _ROW_CACHE = 512  # compliance rows of probed nodes kept between steps
 
 
 def _nbytes(a) -> int:
-    if isinstance(a, np.ndarray):
-        return a.nbytes
+    if isinstance(a, np.ndarray) or getattr(a, "is_fast", False):
+        return int(a.nbytes)
     if sp.issparse(a):
         a = a.tocsr()
         return a.data.nbytes + a.indices.nbytes + a.indptr.nbytes
@@ -95,6 +95,12 @@ class LaggedStepper:
         t1 = time.perf_counter()
         self.C = substrate.compliance_operator(disc)
         self.dense = isinstance(self.C, np.ndarray)
+        self.fast = bool(getattr(self.C, "is_fast", False))
+        if self.fast and name == "lu":
+            raise SceneError(
+                "linear_solver='lu' needs the dense elastic operator: use operator='dense' "
+                "(if the mesh fits) or linear_solver='gmres' with the fast operator."
+            )
         t2 = time.perf_counter()
         self.origin = np.zeros((1, 2))
         self.centre_row = substrate.deflection_rows(disc, self.origin)
@@ -112,6 +118,7 @@ class LaggedStepper:
                 "linear_solver": name,
                 "terms": [t.name for t in self.terms],
                 "elastic_build_s": t2 - t1,
+                **({"fast_operator": dict(self.C.info)} if self.fast else {}),
                 "operator_bytes": int(_nbytes(self.C)),
                 **{f"{t.name}_assembled": False for t in self.terms},
                 "factorizations": 0,
@@ -134,7 +141,10 @@ class LaggedStepper:
         pair = self._FC.get(term.name)
         if pair is None:
             F = term.film_operator()
-            FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
+            if self.fast:  # never formed: the sparse near-field product, for the preconditioner
+                FC = sp.csr_matrix(F @ self.C.preconditioner)
+            else:
+                FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
             pair = self._FC[term.name] = (F, FC)
             self.info["operator_bytes"] += _nbytes(FC)
             self.info[f"{term.name}_assembled"] = True

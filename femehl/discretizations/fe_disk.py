@@ -35,6 +35,13 @@ __all__ = ["FEDisc"]
 #: the mesh name that asks for a mesh fitted to the scene (:func:`femehl.fe.fitted.fitted_disk`)
 FITTED = "fitted"
 
+#: the elastic operators an FE disk can build (``operator=``); "auto" picks by size
+OPERATORS = ("dense", "fast", "auto")
+
+#: "auto" uses the fast operator from this many elements on (or when the dense one does
+#: not fit in memory): the measured crossover of the time per step, benchmarks/fast_operator.md
+FAST_CROSSOVER = 12_000
+
 
 def _horizon(scene) -> float:
     """The span a fitted mesh covers when the run's end is not known: every breakpoint, >= 10."""
@@ -58,13 +65,39 @@ class FEDisc(P1P0):
         any mesh meshio reads.
     half : bool, optional
         Use the half disk y >= 0; default: True when the indenter is symmetric in y.
+    operator : {"auto", "dense", "fast"}, default: "auto"
+        The elastic operator: the dense exact matrix, or the hierarchical approximation
+        of :mod:`femehl.hmatrix` (memory and work per product O(N log N), relative
+        operator error about ``operator_tol``; its steps are solved by Krylov iterations
+        preconditioned with a sparse LU of the near field).  "auto": fast from
+        :data:`FAST_CROSSOVER` elements on, or when the dense operator does not fit in
+        memory.
+    operator_tol : float, default: 1e-6
+        Relative error of the fast operator (sets its interpolation order).
     """
 
     dimension = 2
     default_linear_solver = "gmres"
+    #: options that choose how the operators are computed, not the discretization
+    operator_options = ("operator", "operator_tol")
 
-    def __init__(self, scene, mesh="medium", half: bool | None = None):
+    def __init__(
+        self,
+        scene,
+        mesh="medium",
+        half: bool | None = None,
+        operator: str = "auto",
+        operator_tol: float = 1e-6,
+    ):
         t0 = time.perf_counter()
+        if not isinstance(operator, str) or operator not in OPERATORS:
+            raise SceneError(f"operator must be one of {', '.join(map(repr, OPERATORS))}, got {operator!r}.")
+        if (
+            isinstance(operator_tol, bool)
+            or not isinstance(operator_tol, (int, float))
+            or not (1e-12 <= operator_tol < 0.1)
+        ):
+            raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {operator_tol!r}.")
         self.scene = scene
         symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
         if half is not None and not isinstance(half, (bool, np.bool_)):
@@ -105,14 +138,34 @@ class FEDisc(P1P0):
         mult = 2.0 if self.half else 1.0
         self.load_weights = mult * self.node_weight[self.free]
         self._finder_ = None
+        self.operator = self._resolve_operator(operator, ne)
+        self.operator_tol = float(operator_tol)
         self.info = {
             "mesh": dm.name,
             "half": dm.half,
             "elements": ne,
             "nodes": nn,
             "unknowns": self.n,
+            "operator": self.operator,
             "setup_s": time.perf_counter() - t0,
         }
+
+    def _resolve_operator(self, operator, ne):
+        """The operator to build, checked against the machine's memory."""
+        from ..fe.mesh import (
+            _OPERATOR_COPIES,
+            MEMORY_FRACTION,
+            check_mesh_memory,
+            machine_memory,
+            operator_bytes,
+        )
+
+        if operator == "auto":
+            memory = machine_memory()
+            fits = memory is None or _OPERATOR_COPIES * operator_bytes(ne, self.n) <= MEMORY_FRACTION * memory
+            operator = "fast" if ne >= FAST_CROSSOVER or not fits else "dense"
+        check_mesh_memory(ne, self.n, self.dm.name, operator=operator)
+        return operator
 
     # ---- geometry ------------------------------------------------------------------------
     @property
@@ -159,12 +212,18 @@ class FEDisc(P1P0):
         return R[:, self.free]
 
     def boussinesq(self):
-        """Dense ``X P[:, free]``: exact ``int_T dA'/|c_i - x'|`` of the element averages.
+        """``X P[:, free]``: exact ``int_T dA'/|c_i - x'|`` of the element averages.
+
+        Dense, or with ``operator="fast"`` a :class:`femehl.hmatrix.FastCompliance`.
 
         X is never stored: with the signed edge incidence S of :func:`mesh_edges`, X = T S
         where T holds one exact term per unique edge, so a block of rows is T_block (S P).
         For a half disk the mirror images (orientation reversed) add -T_mirror S.
         """
+        if self.operator == "fast":
+            from ..hmatrix import FastCompliance
+
+            return FastCompliance(self, tol=self.operator_tol)
         ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
         SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse

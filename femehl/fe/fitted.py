@@ -549,7 +549,9 @@ def fitted_disk(
             f"fitted_disk: level = {sizes.level:g} would make about {ne:.3g} elements, more than "
             f"{MAX_GMSH_ELEMENTS:.0e}; pass a larger level"
         )
-    check_mesh_memory(int(ne), int(ne / 2), f"fitted_disk(level={sizes.level:g}) (estimated)")
+    check_mesh_memory(
+        int(ne), int(ne / 2), f"fitted_disk(level={sizes.level:g}) (estimated)", operator="fast"
+    )
     dm = sized_disk(sizes.L, half, sizes.size, name)
     if cache:
         try:

@@ -95,6 +95,7 @@ __all__ = [
     "LADDER",
     "LADDER_RATIO",
     "MAX_GMSH_ELEMENTS",
+    "FAST_BYTES_PER_ELEMENT",
     "MEMORY_FRACTION",
     "DiskMesh",
     "areas",
@@ -299,16 +300,35 @@ def _gb(n: float) -> str:
     return f"{n / 1e9:.3g} GB"
 
 
-def check_mesh_memory(n_elements: int, n_free: int, name: str, memory: int | None = None) -> None:
-    """Raise MeshError if the dense elastic operator of this mesh would not fit in memory.
+#: bytes per element of the fast (hierarchical) elastic operator with its preconditioner,
+#: an upper bound of the measured figures (benchmarks/fast_operator.md)
+FAST_BYTES_PER_ELEMENT = 40_000
 
-    The half-space substrate needs a dense ``elements x free nodes`` float64 operator,
-    and the solver holds about ``_OPERATOR_COPIES`` arrays of that size (system, LU).
-    Refused when that exceeds :data:`MEMORY_FRACTION` of the physical memory
-    (``memory``, default :func:`machine_memory`; no check if it is unknown).
+
+def check_mesh_memory(
+    n_elements: int, n_free: int, name: str, memory: int | None = None, operator: str = "dense"
+) -> None:
+    """Raise MeshError if the elastic operator of this mesh would not fit in memory.
+
+    ``operator="dense"``: the half-space substrate's dense ``elements x free nodes``
+    float64 operator, of which the solver holds about ``_OPERATOR_COPIES`` arrays
+    (system, LU).  ``operator="fast"``: :data:`FAST_BYTES_PER_ELEMENT` per element (the
+    hierarchical operator of :mod:`femehl.hmatrix`).  Refused when that exceeds
+    :data:`MEMORY_FRACTION` of the physical memory (``memory``, default
+    :func:`machine_memory`; no check if it is unknown).
     """
     memory = machine_memory() if memory is None else memory
     if memory is None:
+        return
+    if operator == "fast":
+        need = FAST_BYTES_PER_ELEMENT * int(n_elements)
+        if need > MEMORY_FRACTION * memory:
+            raise MeshError(
+                f"mesh {name}: {n_elements} elements need about {_gb(need)} even with the fast "
+                f"elastic operator ({FAST_BYTES_PER_ELEMENT // 1000} kB per element), more than "
+                f"{MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} of memory; use larger mesh "
+                "sizes (a larger level) or a machine with more memory"
+            )
         return
     one = operator_bytes(n_elements, n_free)
     need = _OPERATOR_COPIES * one
@@ -317,8 +337,8 @@ def check_mesh_memory(n_elements: int, n_free: int, name: str, memory: int | Non
             f"mesh {name}: {n_elements} elements and about {n_free} free nodes need a dense elastic "
             f"operator of {_gb(one)} (elements x free nodes x 8 bytes), about {_gb(need)} with the "
             f"LU working copies, more than {MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} "
-            f"of memory; use a coarser mesh (a ladder name: {', '.join(LADDER)}) or larger "
-            "mesh sizes"
+            f"of memory; use operator='fast' (or 'auto', the default), a coarser mesh (a ladder "
+            f"name: {', '.join(LADDER)}) or larger mesh sizes"
         )
 
 
@@ -437,10 +457,10 @@ def graded_disk(
         raise MeshError(
             f"graded_disk: sizes h_far = {h_far}, h_contact = {h_contact}, h_edge = {h_edge} on L = "
             f"{L:g} would make about {ne:.3g} elements, more than {MAX_GMSH_ELEMENTS:.0e} (gmsh "
-            "would run for hours and no machine holds the dense elastic operator); pass larger "
+            "would run for hours); pass larger "
             "mesh sizes"
         )
-    check_mesh_memory(int(ne), int(ne / 2), f"graded_disk(L={L:g}, ...) (estimated)")
+    check_mesh_memory(int(ne), int(ne / 2), f"graded_disk(L={L:g}, ...) (estimated)", operator="fast")
     return sized_disk(L, bool(half), lambda x, y: h(math.hypot(x, y)), name)
 
 
@@ -707,7 +727,7 @@ def _check_memory_of(t, name) -> None:
     """check_mesh_memory for triangles ``t`` (3, ne): free nodes estimated by the used nodes."""
     t = np.asarray(t)
     if t.ndim == 2 and t.shape[0] >= 3 and t.size:
-        check_mesh_memory(t.shape[1], np.unique(t[:3]).size, name)
+        check_mesh_memory(t.shape[1], np.unique(t[:3]).size, name, operator="fast")
 
 
 def _check_l(L) -> None:

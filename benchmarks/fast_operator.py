@@ -1,0 +1,298 @@
+"""Benchmark: the fast (hierarchical) elastic operator against the dense one.
+
+``python benchmarks/fast_operator.py`` (or ``femehl bench fast_operator``) runs, each case in
+its own process (so the peak memory is the case's own), the paper sphere on fitted
+half-disk meshes from about 3,000 to 500,000 elements:
+
+* ``case``: the first ``--steps`` steps of the paper case (BDF2, dt = 0.01) with one
+  operator; prints one JSON line: elements, set-up s, ms per step (steps 5 onwards, the
+  contact forming), Krylov iterations per step, peak RSS, operator bytes;
+* ``agree``: the whole paper case to t = 5 with both operators on one mesh: the largest
+  relative difference of load, central and minimum film over every step;
+* the driver (no sub-command) runs the ladder and writes ``fast_operator.jsonl``,
+  ``fast_operator.md`` and ``fast_operator.png`` next to this file.
+
+Threads are pinned to one (``OMP_NUM_THREADS=1`` ...), as in every femehl benchmark.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", MPLBACKEND="Agg")
+
+#: fitted-mesh levels of the ladder (about 3k .. 500k half-disk elements)
+LEVELS = [1.0, 0.5, 0.35, 0.25, 0.177, 0.125, 0.088, 0.0625]
+#: the dense path is run where it fits (elements x free nodes x 8 bytes x 4 copies < 60 % RAM)
+DENSE_LEVELS = [1.0, 0.5, 0.35]
+
+
+def _scene():
+    from femehl.presets import paper_sphere
+
+    return paper_sphere()
+
+
+def case(level: float, operator: str, steps: int) -> dict:
+    import numpy as np
+
+    import femehl
+    from femehl.fe.fitted import fitted_disk
+
+    scene = _scene()
+    t0 = time.perf_counter()
+    dm = fitted_disk(scene, 5.0, level)
+    t_mesh = time.perf_counter() - t0
+    stamps = []
+    t1 = time.perf_counter()
+    res = femehl.solve(
+        scene,
+        t_end=steps * 0.01,
+        dt=0.01,
+        mesh=dm,
+        scheme="bdf2",
+        operator=operator,
+        estimate=False,
+        store_every=0,
+        callback=lambda s: stamps.append((time.perf_counter(), s.info.get("krylov_iterations", 0))),
+    )
+    wall = time.perf_counter() - t1
+    info = res.info
+    per = np.diff([t1 + info["setup_s"]] + [t for t, _ in stamps])
+    its = [k for _, k in stamps]
+    return {
+        "level": level,
+        "operator": operator,
+        "elements": info["elements"],
+        "unknowns": info["unknowns"],
+        "mesh_s": t_mesh,
+        "setup_s": info["setup_s"],
+        "ms_per_step": 1e3 * float(np.mean(per[5:])),
+        "krylov_per_step": float(np.mean(its[5:])),
+        "krylov_max": int(max(its[5:])),
+        "factorizations": info["factorizations"],
+        "operator_bytes": info["operator_bytes"],
+        "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+        "wall_s": wall,
+        "steps": steps,
+        "fast": info.get("fast_operator"),
+    }
+
+
+def agree(level: float, t_end: float) -> dict:
+    import numpy as np
+
+    import femehl
+    from femehl.fe.fitted import fitted_disk
+
+    scene = _scene()
+    dm = fitted_disk(scene, 5.0, level)
+    out = {"level": level, "t_end": t_end}
+    runs = {}
+    for op in ("dense", "fast"):
+        t0 = time.perf_counter()
+        runs[op] = femehl.solve(
+            scene, t_end=t_end, dt=0.01, mesh=dm, scheme="bdf2", operator=op, estimate=False, store_every=0
+        )
+        out[f"{op}_s"] = time.perf_counter() - t0
+    out["elements"] = runs["fast"].info["elements"]
+    for q in ("load", "film_center", "film_min"):
+        a = np.asarray(getattr(runs["dense"], q))
+        b = np.asarray(getattr(runs["fast"], q))
+        scale = np.maximum(np.abs(a), 1e-3 * np.max(np.abs(a)))
+        out[q] = float(np.max(np.abs(a - b) / scale))
+    return out
+
+
+def _run(args: list[str], timeout: float) -> dict | None:
+    try:
+        p = subprocess.run(
+            [sys.executable, __file__, *args], env=ENV, capture_output=True, text=True, timeout=timeout
+        )
+    except subprocess.TimeoutExpired:
+        return {"args": args, "error": f"timeout {timeout:.0f} s"}
+    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
+    if p.returncode or not lines:
+        return {"args": args, "error": (p.stderr or p.stdout)[-600:]}
+    return json.loads(lines[-1])
+
+
+def machine() -> str:
+    import numpy
+    import scipy
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    return (
+        f"{os.cpu_count()} cores ({cpu}), {mem:.0f} GiB RAM, python {platform.python_version()}, "
+        f"numpy {numpy.__version__}, scipy {scipy.__version__}, 1 BLAS thread per run"
+    )
+
+
+def fit_exponent(n, y):
+    import numpy as np
+
+    ln, ly = np.log(np.asarray(n, float)), np.log(np.asarray(y, float))
+    return float(np.polyfit(ln, ly, 1)[0])
+
+
+def write(rows: list[dict], agreements: list[dict], path_md: Path, path_png: Path) -> None:
+    import numpy as np
+
+    ok = [r for r in rows if "error" not in r]
+    fast = sorted([r for r in ok if r["operator"] == "fast"], key=lambda r: r["elements"])
+    dense = sorted([r for r in ok if r["operator"] == "dense"], key=lambda r: r["elements"])
+    lines = [
+        "# Fast (hierarchical) elastic operator against the dense one",
+        "",
+        f"Generated by `python benchmarks/fast_operator.py`. Machine: {machine()}. Load average at the "
+        f"end: {os.getloadavg()[0]:.2f}.",
+        "",
+        "Paper sphere (beta = 200), fitted half-disk meshes, BDF2 at dt = 0.01; ms per step is the "
+        "mean over steps 5 to the last of the first `steps` steps (the contact forming), Krylov "
+        "iterations per step likewise; peak RSS is the whole process (mesh, operators, solver). "
+        "Each case ran in its own process, one after another.",
+        "",
+        "| operator | elements | set-up s | ms / step | Krylov / step (max) | operator bytes / element "
+        "| peak RSS GiB | steps |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in sorted(ok, key=lambda r: (r["elements"], r["operator"])):
+        lines.append(
+            f"| {r['operator']} | {r['elements']} | {r['setup_s']:.1f} | {r['ms_per_step']:.0f} | "
+            f"{r['krylov_per_step']:.1f} ({r['krylov_max']}) | {r['operator_bytes'] / r['elements']:.0f} | "
+            f"{r['peak_rss'] / 2**30:.2f} | {r['steps']} |"
+        )
+    for r in rows:
+        if "error" in r:
+            lines.append(f"| failed | {' '.join(r['args'])} | {r['error'][-200:]!r} |  |  |  |  |  |")
+    lines.append("")
+    if len(fast) >= 3:
+        n = [r["elements"] for r in fast]
+        lines.append(
+            f"Fitted exponents over the fast ladder ({n[0]} to {n[-1]} elements): time per step "
+            f"N^{fit_exponent(n, [r['ms_per_step'] for r in fast]):.2f}, set-up "
+            f"N^{fit_exponent(n, [r['setup_s'] for r in fast]):.2f}, operator bytes "
+            f"N^{fit_exponent(n, [r['operator_bytes'] for r in fast]):.2f}, peak RSS "
+            f"N^{fit_exponent(n, [r['peak_rss'] for r in fast]):.2f} (N log N is about N^1.1 here)."
+        )
+        lines.append("")
+    pairs = [(d, f) for d in dense for f in fast if f["elements"] == d["elements"]]
+    if pairs:
+        lines.append("Fast against dense on the same mesh:")
+        lines.append("")
+        lines.append(
+            "| elements | time per step dense / fast | peak RSS dense / fast | operator bytes dense / fast |"
+        )
+        lines.append("|---|---|---|---|")
+        for d, f in pairs:
+            lines.append(
+                f"| {d['elements']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
+                f"{d['peak_rss'] / f['peak_rss']:.2f} | {d['operator_bytes'] / f['operator_bytes']:.2f} |"
+            )
+        lines.append("")
+    if agreements:
+        lines.append("Agreement over the whole paper case (every step, relative to the dense run):")
+        lines.append("")
+        lines.append("| elements | t_end | load | central film | minimum film | dense s | fast s |")
+        lines.append("|---|---|---|---|---|---|---|")
+        for a in agreements:
+            if "error" in a:
+                lines.append(f"| failed | {a['error'][-200:]!r} |  |  |  |  |  |")
+                continue
+            lines.append(
+                f"| {a['elements']} | {a['t_end']:g} | {a['load']:.1e} | {a['film_center']:.1e} | "
+                f"{a['film_min']:.1e} | {a['dense_s']:.0f} | {a['fast_s']:.0f} |"
+            )
+        lines.append("")
+    path_md.write_text("\n".join(lines) + "\n")
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    for rs, lab, m in ((dense, "dense", "s-"), (fast, "fast", "o-")):
+        if rs:
+            n = [r["elements"] for r in rs]
+            ax[0].loglog(n, [r["ms_per_step"] for r in rs], m, label=lab)
+            ax[1].loglog(n, [r["peak_rss"] / 2**30 for r in rs], m, label=f"{lab}: peak RSS")
+            ax[1].loglog(
+                n, [r["operator_bytes"] / 2**30 for r in rs], m.replace("-", "--"), label=f"{lab}: operator"
+            )
+    if fast:
+        n = np.array([r["elements"] for r in fast], float)
+        ref = fast[0]["ms_per_step"] * (n * np.log(n)) / (n[0] * math.log(n[0]))
+        ax[0].loglog(n, ref, "k:", label="N log N")
+    ax[0].set(xlabel="elements", ylabel="ms per step", title="time per step")
+    ax[1].set(xlabel="elements", ylabel="GiB", title="memory")
+    for a in ax:
+        a.grid(True, which="both", alpha=0.3)
+        a.legend()
+    fig.tight_layout()
+    fig.savefig(path_png, dpi=110)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd")
+    c = sub.add_parser("case")
+    c.add_argument("--level", type=float, required=True)
+    c.add_argument("--operator", default="fast")
+    c.add_argument("--steps", type=int, default=30)
+    g = sub.add_parser("agree")
+    g.add_argument("--level", type=float, required=True)
+    g.add_argument("--t-end", type=float, default=5.0)
+    ap.add_argument("--levels", type=float, nargs="*", default=LEVELS)
+    ap.add_argument("--dense-levels", type=float, nargs="*", default=DENSE_LEVELS)
+    ap.add_argument("--agree-levels", type=float, nargs="*", default=[1.0, 0.5])
+    ap.add_argument("--steps", type=int, default=30)
+    ap.add_argument("--timeout", type=float, default=5400.0)
+    ap.add_argument("--out", type=Path, default=HERE / "fast_operator")
+    a = ap.parse_args(argv)
+    if a.cmd == "case":
+        print(json.dumps(case(a.level, a.operator, a.steps)))
+        return 0
+    if a.cmd == "agree":
+        print(json.dumps(agree(a.level, a.t_end)))
+        return 0
+    jsonl = a.out.with_suffix(".jsonl")
+    rows, agreements = [], []
+    with jsonl.open("w") as fh:
+        for level in a.levels:
+            for op in ("dense", "fast") if level in a.dense_levels else ("fast",):
+                r = _run(
+                    ["case", "--level", str(level), "--operator", op, "--steps", str(a.steps)], a.timeout
+                )
+                rows.append(r)
+                fh.write(json.dumps(r) + "\n")
+                fh.flush()
+                print(json.dumps(r), flush=True)
+        for level in a.agree_levels:
+            r = _run(["agree", "--level", str(level)], a.timeout)
+            r["kind"] = "agree"
+            agreements.append(r)
+            fh.write(json.dumps(r) + "\n")
+            print(json.dumps(r), flush=True)
+    write(rows, agreements, a.out.with_suffix(".md"), a.out.with_suffix(".png"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

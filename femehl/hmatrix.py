@@ -1,0 +1,538 @@
+"""A hierarchical (H^2) approximation of the Boussinesq operator: memory and work O(N log N).
+
+The dense elastic operator ``X[i, j] = int_{T_j} dA' / |c_i - x'|`` (element centroids
+``c_i``, triangles ``T_j``, :mod:`femehl.kernels`) costs ``8 N^2`` bytes.  This module
+approximates it as
+
+    X = X_near + sum over admissible blocks (tau, sigma) of  S_tau K_{tau sigma} Q_sigma,
+
+the standard H^2 matrix with Chebyshev interpolation (the "black-box FMM" of Fong and
+Darve 2009, with the block partition of an H-matrix):
+
+* two cluster trees, of the targets (centroids) and of the sources (triangles, with their
+  mirror images for a half disk), by bisection of bounding boxes at the median, leaves of
+  at most ``leaf`` items;
+* a block (tau, sigma) is *admissible* when ``max(diam tau, diam sigma) <= eta dist(tau,
+  sigma)`` (bounding boxes; the source box holds the whole triangles).  There the kernel
+  is interpolated on tensor Chebyshev grids of ``p x p`` points in both boxes:
+  ``1/|x - y| ~ sum_ab l_a(x) K(xi_a, eta_b) l_b(y)``; the error falls geometrically with
+  ``p`` (measured in ``benchmarks/fast_operator.md``);
+* every other block of two leaves is kept exactly (``X_near``, sparse): the exact
+  triangle integrals of :mod:`femehl.kernels`, so the singular and nearly singular
+  interactions are never approximated;
+* the grids are nested: a parent's moments are its children's, re-interpolated (exact
+  for the polynomials of degree ``p - 1``), so the cluster bases are stored only at the
+  leaves: ``Q`` (moments ``int_T l_b`` by a Gauss rule exact for the degree ``2 (p - 1)``)
+  and ``S`` (the Lagrange basis at the centroids).
+
+``apply(u)`` is an upward pass (moments), one batched product per admissible block
+(``K`` kept with its singular values truncated at ``svd_tol`` relative to the block's
+largest), a downward pass and the sparse near field: no loop over elements or blocks in
+Python.  ``X_near`` is also what the fast path's preconditioner factors
+(:mod:`femehl.core.linsolve`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["ClusterTree", "FastCompliance", "H2Operator", "cluster_tree", "order_for", "pair_influence"]
+
+
+# ---- small pieces -----------------------------------------------------------------------
+def pair_influence(points, tri):
+    """Exact ``int_{T_k} dA' / |A_k - x'|`` for paired field points and triangles (k = 0..m-1)."""
+    from .kernels import _edge_term, _orientation
+
+    ax, ay = points[:, 0], points[:, 1]
+    acc = _edge_term(ax, ay, tri[:, 0, 0], tri[:, 0, 1], tri[:, 1, 0], tri[:, 1, 1])
+    acc += _edge_term(ax, ay, tri[:, 1, 0], tri[:, 1, 1], tri[:, 2, 0], tri[:, 2, 1])
+    acc += _edge_term(ax, ay, tri[:, 2, 0], tri[:, 2, 1], tri[:, 0, 0], tri[:, 0, 1])
+    return acc * _orientation(tri)
+
+
+def _cheb(p):
+    return np.cos((2.0 * np.arange(p) + 1.0) * np.pi / (2.0 * p))  # in (-1, 1)
+
+
+def _lagrange(s, nodes):
+    """``l_k(s)`` for scaled coordinates ``s`` (m,) and nodes (p,): (m, p)."""
+    p = nodes.size
+    diff = s[:, None] - nodes[None, :]
+    out = np.empty((s.size, p))
+    for k in range(p):
+        others = np.delete(np.arange(p), k)
+        out[:, k] = np.prod(diff[:, others], axis=1) / np.prod(nodes[k] - nodes[others])
+    return out
+
+
+def _triangle_rule(degree):
+    """Collapsed Gauss-Legendre rule on the reference triangle, exact to ``degree``.
+
+    Returns barycentric coordinates (q, 3) and weights (q,) summing to 1.
+    """
+    n = degree // 2 + 1
+    x, w = np.polynomial.legendre.leggauss(n)
+    u, v = (x + 1.0) / 2.0, w / 2.0
+    U, V = np.meshgrid(u, u, indexing="ij")
+    WU, WV = np.meshgrid(v, v, indexing="ij")
+    # Duffy: (a, b) in the square -> (a, (1 - a) b); Jacobian (1 - a); one extra degree in a
+    a, b = U.ravel(), V.ravel()
+    lam1, lam2 = a, (1.0 - a) * b
+    wts = (WU * WV).ravel() * (1.0 - a) * 2.0
+    return np.column_stack([1.0 - lam1 - lam2, lam1, lam2]), wts / wts.sum()
+
+
+# ---- cluster trees ----------------------------------------------------------------------
+@dataclass
+class ClusterTree:
+    """Bisection tree: node ``k`` holds ``perm[start[k]:stop[k]]`` inside box ``lo[k]..hi[k]``."""
+
+    perm: np.ndarray
+    start: np.ndarray
+    stop: np.ndarray
+    lo: np.ndarray  # (nodes, 2)
+    hi: np.ndarray
+    left: np.ndarray  # -1 at a leaf
+    right: np.ndarray
+    parent: np.ndarray
+    depth: np.ndarray
+
+    @property
+    def size(self):
+        return self.stop - self.start
+
+    @property
+    def leaf(self):
+        return self.left < 0
+
+    @property
+    def diam(self):
+        return np.hypot(*(self.hi - self.lo).T)
+
+
+def cluster_tree(centers, lo_items, hi_items, leaf: int = 32) -> ClusterTree:
+    """Split at the median of the centres along the longest side until ``<= leaf`` items."""
+    n = centers.shape[0]
+    perm = np.arange(n)
+    start, stop, parent, depth = [0], [n], [-1], [0]
+    left, right = [-1], [-1]
+    k = 0
+    while k < len(start):
+        s, e = start[k], stop[k]
+        if e - s > leaf:
+            idx = perm[s:e]
+            c = centers[idx]
+            axis = int(np.argmax(c.max(axis=0) - c.min(axis=0)))
+            half = (e - s) // 2
+            order = np.argpartition(c[:, axis], half)
+            perm[s:e] = idx[order]
+            for a, b in ((s, s + half), (s + half, e)):
+                start.append(a)
+                stop.append(b)
+                parent.append(k)
+                depth.append(depth[k] + 1)
+                left.append(-1)
+                right.append(-1)
+            left[k], right[k] = len(start) - 2, len(start) - 1
+        k += 1
+    start, stop = np.array(start), np.array(stop)
+    # boxes of the items (sources: whole triangles), by a reduction over the permuted order
+    lo_p, hi_p = lo_items[perm], hi_items[perm]
+    lo = np.array([lo_p[a:b].min(axis=0) for a, b in zip(start, stop, strict=True)])
+    hi = np.array([hi_p[a:b].max(axis=0) for a, b in zip(start, stop, strict=True)])
+    # a box of zero width (points on a line): widen it a little; interpolation is exact in any box
+    scale = float(np.max(hi[0] - lo[0])) or 1.0
+    thin = (hi - lo) < 1e-9 * scale
+    mid = 0.5 * (hi + lo)
+    lo = np.where(thin, mid - 0.5e-9 * scale, lo)
+    hi = np.where(thin, mid + 0.5e-9 * scale, hi)
+    return ClusterTree(
+        perm, start, stop, lo, hi, np.array(left), np.array(right), np.array(parent), np.array(depth)
+    )
+
+
+def _box_distance(lo1, hi1, lo2, hi2):
+    gap = np.maximum(0.0, np.maximum(lo1 - hi2, lo2 - hi1))
+    return np.hypot(gap[:, 0], gap[:, 1])
+
+
+def _partition(T, S, eta):
+    """Admissible (far) and near leaf pairs of the block tree, level by level (vectorized)."""
+    pt, ps = np.array([0]), np.array([0])
+    far_t, far_s, near_t, near_s = [], [], [], []
+    dT, dS = T.diam, S.diam
+    while pt.size:
+        dist = _box_distance(T.lo[pt], T.hi[pt], S.lo[ps], S.hi[ps])
+        adm = np.maximum(dT[pt], dS[ps]) <= eta * dist
+        far_t.append(pt[adm])
+        far_s.append(ps[adm])
+        pt, ps = pt[~adm], ps[~adm]
+        lt, ls = T.leaf[pt], S.leaf[ps]
+        both = lt & ls
+        near_t.append(pt[both])
+        near_s.append(ps[both])
+        split_t = ~lt & (ls | (dT[pt] >= dS[ps]))
+        split_s = ~both & ~split_t
+        a, b = pt[split_t], ps[split_t]
+        c, d = pt[split_s], ps[split_s]
+        pt = np.concatenate([T.left[a], T.right[a], c, c])
+        ps = np.concatenate([b, b, S.left[d], S.right[d]])
+    cat = np.concatenate
+    return cat(far_t), cat(far_s), cat(near_t), cat(near_s)
+
+
+def _grid(lo, hi, nodes):
+    """Chebyshev grid points of boxes: (boxes, p, 2) per axis positions."""
+    return lo[:, None, :] + (hi - lo)[:, None, :] * (nodes[None, :, None] + 1.0) / 2.0
+
+
+def _scaled(x, lo, hi):
+    return (2.0 * x - (lo + hi)) / (hi - lo)
+
+
+# ---- the operator -----------------------------------------------------------------------
+class H2Operator:
+    """``X u`` for element values ``u``: near field exact, far field interpolated.
+
+    Parameters
+    ----------
+    targets : (n, 2) array
+        Field points (element centroids).
+    tri : (m, 3, 2) array
+        Source triangles (mirror images included).
+    source_element : (m,) int array
+        Which unknown each source triangle carries (its own element, or the element it is
+        the image of): ``X u`` sums ``int_{T_j} / |c_i - x'| u[source_element[j]]``.
+    p : int
+        Chebyshev points per axis.
+    eta : float
+        Admissibility.
+    leaf : int
+        Items per leaf cluster.
+    svd_tol : float
+        Relative singular-value truncation of the interpolated blocks.
+    """
+
+    def __init__(
+        self, targets, tri, source_element, n_unknowns, p=9, eta=2.0, leaf=64, svd_tol=1e-9, keep=None
+    ):
+        t0 = time.perf_counter()
+        self.p, self.eta, self.leaf = int(p), float(eta), int(leaf)
+        targets = np.asarray(targets, dtype=float)
+        tri = np.asarray(tri, dtype=float)
+        self.n_targets, self.n_sources = targets.shape[0], tri.shape[0]
+        self.n_unknowns = int(n_unknowns)
+        self.source_element = np.asarray(source_element)
+        # gather the unknowns to the sources (sparse so a mirror image sums with its element)
+        self.G = sp.csr_matrix(
+            (np.ones(self.n_sources), (np.arange(self.n_sources), self.source_element)),
+            shape=(self.n_sources, self.n_unknowns),
+        )
+        cen = tri.mean(axis=1)
+        T = cluster_tree(targets, targets, targets, leaf)
+        S = cluster_tree(cen, tri.min(axis=1), tri.max(axis=1), leaf)
+        self.T, self.S = T, S
+        t1 = time.perf_counter()
+        ft, fs, nt, ns = _partition(T, S, self.eta)
+        self.n_far, self.n_near = ft.size, nt.size
+        t2 = time.perf_counter()
+        nodes = _cheb(self.p)
+        self._near_perm, self.kept = self._near_field(targets, tri, T, S, nt, ns, keep)
+        t3 = time.perf_counter()
+        self._build_bases(targets, tri, nodes)
+        self._build_far(nodes, ft, fs, svd_tol)
+        t4 = time.perf_counter()
+        self.info = {
+            "p": self.p,
+            "eta": self.eta,
+            "leaf": self.leaf,
+            "far_blocks": int(self.n_far),
+            "near_blocks": int(self.n_near),
+            "near_nnz": int(self._near_perm.nnz),
+            "far_rank_mean": float(self._rank_mean),
+            "tree_s": t1 - t0,
+            "partition_s": t2 - t1,
+            "near_s": t3 - t2,
+            "far_s": t4 - t3,
+            "bytes": int(self.nbytes),
+        }
+
+    # -- set-up ---------------------------------------------------------------------------
+    def _near_field(self, targets, tri, T, S, nt, ns, keep=None):
+        """Exact entries of every near leaf pair: sparse, rows in the target tree's order.
+
+        Built a group of target leaves at a time (a contiguous row range), so the peak
+        memory is the matrix plus one group.  ``keep(i, j_source)`` -> bool mask selects
+        the entries also returned as ``(rows, element columns, values)`` (the
+        preconditioner's), in natural row order.
+        """
+        order = np.argsort(T.start[nt], kind="stable")
+        nt, ns = nt[order], ns[order]
+        mt, ms = T.size[nt], S.size[ns]
+        sizes = mt * ms
+        leaf_start = np.flatnonzero(np.r_[True, nt[1:] != nt[:-1]]) if nt.size else np.zeros(0, int)
+        csum = np.cumsum(sizes)
+        chunks, kept = [], []
+        budget = 1_000_000
+        lo = 0
+        while lo < nt.size:
+            # extend to whole target leaves, about `budget` entries
+            base = csum[lo - 1] if lo else 0
+            hi = int(np.searchsorted(csum, base + budget, side="right"))
+            hi = max(hi, lo + 1)
+            nxt = leaf_start[leaf_start >= hi]
+            hi = int(nxt[0]) if nxt.size else nt.size
+            bt, bs, bm, bsz = nt[lo:hi], ns[lo:hi], ms[lo:hi], sizes[lo:hi]
+            blk = np.repeat(np.arange(hi - lo), bsz)
+            k = np.arange(blk.size) - np.repeat(np.cumsum(bsz) - bsz, bsz)
+            row = T.start[bt][blk] + k // bm[blk]  # position in T.perm
+            J = S.perm[S.start[bs][blk] + k % bm[blk]]
+            I = T.perm[row]
+            v = pair_influence(targets[I], tri[J])
+            r0 = int(T.start[bt].min())
+            r1 = int((T.start[bt] + T.size[bt]).max())
+            chunks.append(
+                (r0, sp.csr_matrix((v, (row - r0, self.source_element[J])), shape=(r1 - r0, self.n_unknowns)))
+            )
+            if keep is not None:
+                m = keep(I, J)
+                kept.append((I[m], self.source_element[J[m]], v[m]))
+            lo = hi
+        # stack the row ranges (they tile 0..n_targets in order; empty ranges are zero rows)
+        blocks, at = [], 0
+        for r0, M in chunks:
+            if r0 > at:
+                blocks.append(sp.csr_matrix((r0 - at, self.n_unknowns)))
+            blocks.append(M)
+            at = r0 + M.shape[0]
+        if at < self.n_targets:
+            blocks.append(sp.csr_matrix((self.n_targets - at, self.n_unknowns)))
+        near = sp.vstack(blocks, format="csr") if blocks else sp.csr_matrix((self.n_targets, self.n_unknowns))
+        if keep is None:
+            return near, None
+        cat = np.concatenate
+        trio = tuple(cat([k[i] for k in kept]) if kept else np.zeros(0) for i in range(3))
+        return near, trio
+
+    def _build_bases(self, targets, tri, nodes):
+        p, T, S = self.p, self.T, self.S
+        pp = p * p
+        # leaf evaluation S: Lagrange basis of each target's leaf at the target
+        leaves = np.flatnonzero(T.leaf)
+        owner = np.empty(self.n_targets, dtype=np.int64)
+        for k in leaves:
+            owner[T.perm[T.start[k] : T.stop[k]]] = k
+        sx = _scaled(targets[:, 0], T.lo[owner, 0], T.hi[owner, 0])
+        sy = _scaled(targets[:, 1], T.lo[owner, 1], T.hi[owner, 1])
+        vals = (_lagrange(sx, nodes)[:, :, None] * _lagrange(sy, nodes)[:, None, :]).reshape(-1, pp)
+        cols = owner[:, None] * pp + np.arange(pp)[None, :]
+        self._L2P = sp.csr_matrix(
+            (vals.ravel(), (np.repeat(np.arange(self.n_targets), pp), cols.ravel())),
+            shape=(self.n_targets, T.start.size * pp),
+        )
+        # leaf moments Q: int_T l_b(y) dA, Gauss rule exact for degree 2 (p - 1)
+        lam, w = _triangle_rule(2 * (p - 1))
+        owner_s = np.empty(self.n_sources, dtype=np.int64)
+        for k in np.flatnonzero(S.leaf):
+            owner_s[S.perm[S.start[k] : S.stop[k]]] = k
+        e1 = tri[:, 1] - tri[:, 0]
+        e2 = tri[:, 2] - tri[:, 0]
+        area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        Qv = np.zeros((self.n_sources, pp))
+        chunk = max(1, 2_000_000 // (lam.shape[0] * p))
+        for s in range(0, self.n_sources, chunk):
+            sl = slice(s, min(s + chunk, self.n_sources))
+            q = np.einsum("qk,ekd->eqd", lam, tri[sl])  # (e, q, 2)
+            o = owner_s[sl]
+            ax = _lagrange(_scaled(q[:, :, 0], S.lo[o, None, 0], S.hi[o, None, 0]).ravel(), nodes)
+            ay = _lagrange(_scaled(q[:, :, 1], S.lo[o, None, 1], S.hi[o, None, 1]).ravel(), nodes)
+            ax = ax.reshape(q.shape[0], q.shape[1], p) * w[None, :, None]
+            ay = ay.reshape(q.shape[0], q.shape[1], p)
+            Qv[sl] = np.einsum("eqa,eqb->eab", ax, ay).reshape(-1, pp) * area[sl, None]
+        cols = owner_s[:, None] * pp + np.arange(pp)[None, :]
+        self._P2M = sp.csr_matrix(
+            (Qv.ravel(), (cols.ravel(), np.repeat(np.arange(self.n_sources), pp))),
+            shape=(S.start.size * pp, self.n_sources),
+        ).tocsr()
+        # transfer matrices (1-D, per child): parent's Lagrange basis at the child's nodes
+        self._levels_S = self._transfers(S, nodes)
+        self._levels_T = self._transfers(T, nodes)
+
+    def _transfers(self, tree, nodes):
+        """Per depth (deepest first): children, their parents, Wx, Wy (p x p each)."""
+        out = []
+        kids = np.flatnonzero(tree.parent >= 0)
+        is_left = np.zeros(tree.start.size, dtype=bool)
+        is_left[tree.left[tree.left >= 0]] = True
+        for d, side in sorted({(int(tree.depth[k]), bool(is_left[k])) for k in kids}, reverse=True):
+            # one side at a time: every parent appears once (fancy-index += is then exact)
+            c = kids[(tree.depth[kids] == d) & (is_left[kids] == side)]
+            par = tree.parent[c]
+            g = _grid(tree.lo[c], tree.hi[c], nodes)  # (c, p, 2)
+            wx = _lagrange(_scaled(g[:, :, 0], tree.lo[par, None, 0], tree.hi[par, None, 0]).ravel(), nodes)
+            wy = _lagrange(_scaled(g[:, :, 1], tree.lo[par, None, 1], tree.hi[par, None, 1]).ravel(), nodes)
+            # W[c][a_child, b_parent] = l^parent_b(node^child_a)
+            out.append((c, par, wx.reshape(c.size, self.p, self.p), wy.reshape(c.size, self.p, self.p)))
+        return out
+
+    def _build_far(self, nodes, ft, fs, svd_tol):
+        p, pp = self.p, self.p * self.p
+        T, S = self.T, self.S
+        order = np.argsort(ft, kind="stable")
+        ft, fs = ft[order], fs[order]
+        self._far_t, self._far_s = ft, fs
+        gt = _grid(T.lo[ft], T.hi[ft], nodes)  # (b, p, 2)
+        gs = _grid(S.lo[fs], S.hi[fs], nodes)
+        groups: dict[int, list] = {}  # rank bucket -> [(block index, U, V)] per chunk
+        ranks = []
+        chunk = 2048
+        xt = np.stack(np.meshgrid(np.arange(p), np.arange(p), indexing="ij"), -1).reshape(-1, 2)
+        for s in range(0, ft.size, chunk):
+            sl = slice(s, min(s + chunk, ft.size))
+            X = np.stack([gt[sl, xt[:, 0], 0], gt[sl, xt[:, 1], 1]], -1)  # (b, pp, 2)
+            Y = np.stack([gs[sl, xt[:, 0], 0], gs[sl, xt[:, 1], 1]], -1)
+            K = 1.0 / np.hypot(X[:, :, None, 0] - Y[:, None, :, 0], X[:, :, None, 1] - Y[:, None, :, 1])
+            u, sv, vt = np.linalg.svd(K)
+            del K
+            r = np.maximum(1, (sv > svd_tol * sv[:, :1]).sum(axis=1))
+            ranks.append(r)
+            bucket = np.minimum(-(-r // 4) * 4, pp)  # ranks rounded up to 4: batched products
+            for rb in np.unique(bucket):
+                sel = np.flatnonzero(bucket == rb)
+                Ub = u[sel, :, :rb] * sv[sel, None, :rb]
+                groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].copy()))
+            del u, vt
+        self._ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
+        self._rank_mean = float(self._ranks.mean()) if self._ranks.size else 0.0
+        self._far_groups = []
+        for rb in sorted(groups):
+            idx = np.concatenate([g[0] for g in groups[rb]])
+            U_r = np.concatenate([g[1] for g in groups[rb]])
+            V_r = np.concatenate([g[2] for g in groups[rb]])
+            groups[rb] = None
+            self._far_groups.append((ft[idx], fs[idx], U_r, V_r))
+        self.n_nodes_T, self.n_nodes_S = T.start.size, S.start.size
+
+    @property
+    def nbytes(self) -> int:
+        n = 0
+        for M in (self._near_perm, self._L2P, self._P2M):
+            n += M.data.nbytes + M.indices.nbytes + M.indptr.nbytes
+        for _, _, U, V in getattr(self, "_far_groups", []):
+            n += U.nbytes + V.nbytes
+        return int(n)
+
+    @property
+    def near(self):
+        """The exact near-field part (sparse, targets x unknowns, natural row order)."""
+        inv = np.empty_like(self.T.perm)
+        inv[self.T.perm] = np.arange(self.T.perm.size)
+        return self._near_perm[inv]
+
+    # -- application ----------------------------------------------------------------------
+    def __matmul__(self, u):
+        u = np.asarray(u, dtype=float)
+        if u.ndim == 2:
+            return np.column_stack([self @ u[:, k] for k in range(u.shape[1])])
+        p, pp = self.p, self.p * self.p
+        M = (self._P2M @ (self.G @ u)).reshape(self.n_nodes_S, p, p)
+        for c, par, wx, wy in self._levels_S:  # upward: M_parent += Wx^T M_child Wy
+            M[par] += np.matmul(np.matmul(wx.transpose(0, 2, 1), M[c]), wy)
+        L = np.zeros((self.n_nodes_T, pp))
+        for ft, fs, U, V in self._far_groups:
+            t = np.matmul(V, M[fs].reshape(-1, pp, 1))
+            r = np.matmul(U, t)[:, :, 0]
+            starts = np.flatnonzero(np.r_[True, ft[1:] != ft[:-1]])
+            L[ft[starts]] += np.add.reduceat(r, starts, axis=0)
+        L = L.reshape(self.n_nodes_T, p, p)
+        for c, par, wx, wy in reversed(self._levels_T):  # downward: L_child += Wx L_parent Wy^T
+            L[c] += np.matmul(np.matmul(wx, L[par]), wy.transpose(0, 2, 1))
+        y = self._L2P @ L.reshape(-1)
+        y[self.T.perm] += self._near_perm @ u
+        return y
+
+
+# ---- the compliance of a disk mesh ------------------------------------------------------
+#: relative operator error of the interpolation at p = 5 and its factor per extra order,
+#: measured on the fitted paper-sphere half disks (2,988 and 11,472 elements, eta = 2):
+#: 9e-5 .. 1.3e-4 at p = 5, then a factor of about 4 per order (p = 9: 2e-7 .. 4e-7,
+#: p = 12: 6e-9 .. 8e-9; benchmarks/fast_operator.md)
+_ERR_P5, _ERR_FACTOR = 1.3e-4, 4.0
+
+
+def order_for(tol: float) -> int:
+    """Chebyshev points per axis for a relative operator error ``tol`` (eta = 2)."""
+    need = math.log(max(_ERR_P5 / tol, 1.0)) / math.log(_ERR_FACTOR)
+    return int(min(14, 5 + math.ceil(need - 1e-9)))
+
+
+#: preconditioner: the near-field entries with ``|c_i - c_j| <= PRECOND_RADIUS sqrt(area_j)``
+PRECOND_RADIUS = 4.0
+
+
+class FastCompliance:
+    """``C = factor * X P`` of a disk mesh with ``X`` as an :class:`H2Operator` (never dense).
+
+    Behaves as the dense ``C`` where the stepper needs it: ``C @ z`` (vector or columns),
+    ``shape``, ``C *= factor``, ``nbytes``; and gives the sparse approximation the fast
+    path's preconditioner factors, :attr:`preconditioner` (the near-field entries within
+    :data:`PRECOND_RADIUS` element sizes, times ``P``).
+    """
+
+    is_fast = True
+
+    def __init__(self, disc, tol: float = 1e-6, factor: float = 1.0):
+        if not (isinstance(tol, (int, float)) and 1e-12 <= float(tol) < 1e-1):
+            from .errors import SceneError
+
+            raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {tol!r}.")
+        t0 = time.perf_counter()
+        ne = disc.nelements
+        tri = disc.tri
+        src_el = np.arange(ne)
+        if disc.half:  # mirror images carry the same element values
+            img = tri * np.array([1.0, -1.0])
+            tri = np.concatenate([tri, img])
+            src_el = np.concatenate([src_el, src_el])
+        self.tol = float(tol)
+        cen = disc.centroids
+        radius = PRECOND_RADIUS * np.sqrt(np.abs(disc.areas))
+
+        def keep(i, j):  # near entries within a few element sizes of the source element
+            e = src_el[j]
+            return np.hypot(*(cen[i] - cen[e]).T) <= radius[e]
+
+        self.H = H2Operator(cen, tri, src_el, ne, p=order_for(tol), svd_tol=1e-3 * self.tol, keep=keep)
+        self.P = disc.P[:, disc.free].tocsr()
+        self.factor = float(factor)
+        rows, cols, vals = self.H.kept
+        self.H.kept = None
+        self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ self.P
+        self.shape = (ne, self.P.shape[1])
+        self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
+
+    def __imul__(self, factor):
+        self.factor *= float(factor)
+        return self
+
+    @property
+    def preconditioner(self):
+        """Sparse approximation of ``C`` (near field within a few element sizes)."""
+        return self.factor * self._pre
+
+    @property
+    def nbytes(self) -> int:
+        n = self.H.nbytes
+        for M in (self.P, self._pre):
+            n += M.data.nbytes + M.indices.nbytes + M.indptr.nbytes
+        return int(n)
+
+    def __matmul__(self, z):
+        z = np.asarray(z, dtype=float)
+        return self.factor * (self.H @ (self.P @ z))

@@ -1,0 +1,185 @@
+"""The fast (hierarchical) elastic operator: accuracy, analytic limits, solver behaviour.
+
+Tolerances: the fast operator's default ``operator_tol = 1e-6`` is a relative operator
+error, measured in ``benchmarks/fast_operator.md`` at 1e-7 to 3e-7 on the fitted paper
+meshes; tests hold it to the stated 1e-6 (not to the measured figure), and films of a
+short run to 1e-6 as the issue asks of the paper case.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.special import ellipe
+
+import femehl
+from femehl.discretizations.fe_disk import FEDisc
+from femehl.errors import SceneError
+from femehl.fe.fitted import fitted_disk
+from femehl.hmatrix import FastCompliance, H2Operator, order_for
+from femehl.kernels import triangle_influence
+from femehl.presets import paper_sphere
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return paper_sphere()
+
+
+def _rel(a, b):
+    return float(np.linalg.norm(a - b) / np.linalg.norm(b))
+
+
+@pytest.mark.parametrize("half", [True, False], ids=["half-disk", "full-disk"])
+def test_fast_matches_dense(sphere, half):
+    """Half disk (mirror images) and full disk: fast C z against the dense exact C z."""
+    dm = fitted_disk(sphere, 5.0, 1.0 if half else 1.41, half=half)
+    disc = FEDisc(sphere, mesh=dm, operator="dense")
+    dense = disc.boussinesq()
+    fast = FastCompliance(disc)
+    assert fast.H.n_far > 0, "the mesh must be large enough to have admissible blocks"
+    rng = np.random.default_rng(3)
+    z = rng.standard_normal(disc.n)
+    smooth = np.maximum(0.0, 1.0 - np.hypot(*disc.nodes[disc.free].T) ** 2)
+    for v in (z, smooth):
+        assert _rel(fast @ v, dense @ v) <= 1e-6
+    Z = np.column_stack([z, smooth])
+    assert _rel(fast @ Z, dense @ Z) <= 1e-6  # several columns at once
+    # the near field is exact: its entries are the dense operator's
+    near = fast.H.near.tocoo()
+    X = np.asarray(dense @ np.eye(disc.n)[:, :1]).ravel()  # one column, cheap sanity
+    assert np.all(np.isfinite(near.data)) and X.size == disc.nelements
+
+
+def test_tighter_tolerance_is_more_accurate(sphere):
+    disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
+    dense = disc.boussinesq()
+    z = np.random.default_rng(5).standard_normal(disc.n)
+    errs = {tol: _rel(FastCompliance(disc, tol=tol) @ z, dense @ z) for tol in (1e-4, 1e-8)}
+    assert errs[1e-4] <= 1e-4
+    assert errs[1e-8] <= 1e-8
+    assert order_for(1e-8) > order_for(1e-6) > order_for(1e-4)
+
+
+def test_uniform_pressure_on_a_disk():
+    """X 1 over a triangulated disk of radius a against 2 pi a (centre) and 4 a E(r^2/a^2).
+
+    The polygonal disk misses the area ``dA = pi a^2 - area(polygon)`` near r = a, so at a
+    point at distance >= delta from the rim the exact integral differs from the circle's by
+    at most ``dA / delta``: that bound is the tolerance (no fitted constant).
+    """
+    from skfem import MeshTri
+
+    a = 0.5
+    m = MeshTri.init_circle(6)
+    p = m.p * a
+    tri = np.transpose(p[:, m.t], (2, 1, 0))
+    cen = tri.mean(axis=1)
+    ne = tri.shape[0]
+    H = H2Operator(cen, tri, np.arange(ne), ne, p=order_for(1e-6))
+    assert H.n_far > 0
+    u = H @ np.ones(ne)
+    x1, x2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = 0.5 * np.abs(x1[:, 0] * x2[:, 1] - x1[:, 1] * x2[:, 0]).sum()
+    deficit = np.pi * a**2 - area
+    assert 0 < deficit < 1e-3 * np.pi * a**2
+    r = np.hypot(cen[:, 0], cen[:, 1])
+    inside = r <= 0.8 * a
+    delta = a - r[inside]
+    exact = 4.0 * a * ellipe((r[inside] / a) ** 2)
+    assert np.all(np.abs(u[inside] - exact) <= deficit / delta + 1e-6 * exact)
+    # the centre: 2 pi a
+    centre = triangle_influence(np.zeros((1, 2)), tri).sum()
+    # (the missing slivers lie at distance a cos(pi / sides) .. a from the centre)
+    assert abs(centre - 2 * np.pi * a) <= deficit / (0.99 * a)
+    # and the fast operator agrees with the exact dense integrals to its tolerance
+    exact_dense = triangle_influence(cen, tri).sum(axis=1)
+    assert _rel(u, exact_dense) <= 1e-6
+
+
+@pytest.fixture(scope="module")
+def ladder_runs(sphere):
+    """The first 12 steps of the paper case with the fast operator on two meshes."""
+    out = {}
+    for level in (1.41, 0.71):
+        dm = fitted_disk(sphere, 5.0, level)
+        out[level] = femehl.solve(
+            sphere, t_end=0.12, dt=0.01, mesh=dm, scheme="bdf2", operator="fast", estimate=False
+        )
+    return out
+
+
+def test_krylov_iterations_bounded_under_refinement(ladder_runs):
+    """Four times the elements must not need many more iterations per step.
+
+    A preconditioner that ignored the elastic coupling (the near-field diagonal only) needs
+    24 -> 28 iterations from scratch over the same refinement; the near-field sparse LU
+    4-5 (benchmarks/fast_operator.md).  Bound: the finer mesh within 1.5 x + 1 of the coarser.
+    """
+    its = {}
+    for level, res in ladder_runs.items():
+        assert res.info["operator"] == "fast"
+        its[level] = res.info["krylov_iterations"] / res.nsteps
+    assert ladder_runs[0.71].info["elements"] >= 3 * ladder_runs[1.41].info["elements"]
+    assert its[0.71] <= 1.5 * its[1.41] + 1.0
+    assert its[0.71] <= 15
+
+
+def test_memory_grows_linearly(ladder_runs):
+    """Bytes per element of the fast operator within 1.6 x over a 4 x refinement (dense: 4 x)."""
+    per = {lv: r.info["operator_bytes"] / r.info["elements"] for lv, r in ladder_runs.items()}
+    assert per[0.71] <= 1.6 * per[1.41]
+
+
+def test_short_run_agrees_with_dense(sphere):
+    """Load and films of 20 steps of the paper case: fast against dense to 1e-6."""
+    dm = fitted_disk(sphere, 5.0, 1.0)
+    runs = {
+        op: femehl.solve(sphere, t_end=0.2, dt=0.01, mesh=dm, scheme="bdf2", operator=op, estimate=False)
+        for op in ("dense", "fast")
+    }
+    assert runs["fast"].info["operator"] == "fast" and runs["dense"].info["operator"] == "dense"
+    for q in ("load", "film_center", "film_min"):
+        a, b = np.asarray(getattr(runs["dense"], q)), np.asarray(getattr(runs["fast"], q))
+        scale = np.maximum(np.abs(a), 1e-3 * np.abs(a).max())
+        assert np.max(np.abs(a - b) / scale) <= 1e-6, q
+
+
+def test_auto_picks_by_size(sphere):
+    small = FEDisc(sphere, mesh="coarse")
+    assert small.operator == "dense"
+    from femehl.discretizations import fe_disk
+
+    assert small.nelements < fe_disk.FAST_CROSSOVER
+
+
+@pytest.mark.parametrize(
+    "options, match",
+    [
+        ({"operator": "bogus"}, "operator must be one of"),
+        ({"operator": "fast", "operator_tol": 0.0}, "operator_tol must be"),
+        ({"operator": "fast", "operator_tol": "small"}, "operator_tol must be"),
+        ({"operator": "fast", "linear_solver": "lu"}, "needs the dense elastic operator"),
+    ],
+)
+def test_bad_operator_options(sphere, options, match):
+    with pytest.raises(SceneError, match=match):
+        femehl.solve(sphere, t_end=0.02, dt=0.01, mesh="coarse", estimate=False, **options)
+
+
+def test_operator_keeps_a_run_automatic():
+    from femehl.api import is_automatic
+
+    scene = paper_sphere()
+    assert is_automatic(scene, None, None, {"operator": "fast"})
+    assert not is_automatic(scene, None, None, {"mesh": "coarse", "operator": "fast"})
+
+
+def test_cli_operator_flag(tmp_path, capsys):
+    from femehl.cli import main
+
+    out = tmp_path / "run"
+    argv = ["run", "--mesh", "coarse", "--operator", "fast", "--dt", "0.01", "--t-end", "0.03", "--quiet"]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert (out / "summary.csv").is_file()
+    assert "operator=fast" in capsys.readouterr().err

@@ -220,10 +220,21 @@ class H2Operator:
     """
 
     def __init__(
-        self, targets, tri, source_element, n_unknowns, p=9, eta=2.0, leaf=64, svd_tol=1e-9, keep=None
+        self,
+        targets,
+        tri,
+        source_element,
+        n_unknowns,
+        p=9,
+        eta=2.0,
+        leaf=64,
+        svd_tol=1e-9,
+        keep=None,
+        dtype=np.float64,
     ):
         t0 = time.perf_counter()
         self.p, self.eta, self.leaf = int(p), float(eta), int(leaf)
+        self.dtype = np.dtype(dtype)  # of the far-field factors (the near field is float64)
         targets = np.asarray(targets, dtype=float)
         tri = np.asarray(tri, dtype=float)
         self.n_targets, self.n_sources = targets.shape[0], tri.shape[0]
@@ -405,8 +416,8 @@ class H2Operator:
             bucket = np.minimum(-(-r // 4) * 4, pp)  # ranks rounded up to 4: batched products
             for rb in np.unique(bucket):
                 sel = np.flatnonzero(bucket == rb)
-                Ub = u[sel, :, :rb] * sv[sel, None, :rb]
-                groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].copy()))
+                Ub = (u[sel, :, :rb] * sv[sel, None, :rb]).astype(self.dtype)
+                groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].astype(self.dtype)))
             del u, vt
         self._ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
         self._rank_mean = float(self._ranks.mean()) if self._ranks.size else 0.0
@@ -445,8 +456,9 @@ class H2Operator:
         for c, par, wx, wy in self._levels_S:  # upward: M_parent += Wx^T M_child Wy
             M[par] += np.matmul(np.matmul(wx.transpose(0, 2, 1), M[c]), wy)
         L = np.zeros((self.n_nodes_T, pp))
+        Mf = M.reshape(-1, pp).astype(self.dtype, copy=False)
         for ft, fs, U, V in self._far_groups:
-            t = np.matmul(V, M[fs].reshape(-1, pp, 1))
+            t = np.matmul(V, Mf[fs][:, :, None])
             r = np.matmul(U, t)[:, :, 0]
             starts = np.flatnonzero(np.r_[True, ft[1:] != ft[:-1]])
             L[ft[starts]] += np.add.reduceat(r, starts, axis=0)
@@ -508,7 +520,9 @@ class FastCompliance:
             e = src_el[j]
             return np.hypot(*(cen[i] - cen[e]).T) <= radius[e]
 
-        self.H = H2Operator(cen, tri, src_el, ne, p=order_for(tol), svd_tol=1e-3 * self.tol, keep=keep)
+        # double precision throughout: single-precision far factors (half the memory) put a
+        # rounding floor of about 1e-7 under the Krylov residual, above its rtol = 1e-8
+        self.H = H2Operator(cen, tri, src_el, ne, p=order_for(tol), svd_tol=0.1 * self.tol, keep=keep)
         self.P = disc.P[:, disc.free].tocsr()
         self.factor = float(factor)
         rows, cols, vals = self.H.kept

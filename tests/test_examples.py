@@ -62,6 +62,18 @@ def check_custom_shape(mod, tmp_path):
     assert o["load"] == pytest.approx(0.44556, rel=0.015)
 
 
+def check_textured_sphere(mod, tmp_path):
+    """The dimpled sphere on a small mesh (4k elements instead of 200k) through the indentation
+    and the start of sliding, with the fast operator forced: load and films equal those of
+    the dense operator on the same mesh to 1e-6 (the fast operator's stated accuracy)."""
+    fast = mod.main(out=tmp_path, t_end=1.2, elements=4000, dt=0.02, operator="fast")
+    dense = mod.main(out=tmp_path / "dense", t_end=1.2, elements=4000, dt=0.02, operator="dense")
+    assert fast["operator"] == "fast" and dense["operator"] == "dense" and fast["half"] is False
+    assert 3000 <= fast["elements"] <= 5000
+    for q in ("load", "film_center", "film_min"):
+        assert fast[q] == pytest.approx(dense[q], rel=1e-6), q
+
+
 def check_cylinder_winkler(mod, tmp_path):
     """Line contact on a Winkler foundation: the long-time state matches the exact steady
     solution (quadrature and shooting)."""
@@ -87,9 +99,10 @@ CHECKS = {
     "ellipsoid_sliding": check_ellipsoid_sliding,
     "custom_shape": check_custom_shape,
     "cylinder_winkler": check_cylinder_winkler,
+    "textured_sphere": check_textured_sphere,
     "paper_figures": check_paper_figures,
 }
-WRITES_RUN_FOLDER = {"load_controlled", "ellipsoid_sliding", "custom_shape"}
+WRITES_RUN_FOLDER = {"load_controlled", "ellipsoid_sliding", "custom_shape", "textured_sphere"}
 
 
 @pytest.mark.parametrize("name", sorted(CHECKS))

@@ -8,6 +8,8 @@ short run to 1e-6 as the issue asks of the paper case.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.special import ellipe
@@ -19,6 +21,8 @@ from femehl.fe.fitted import fitted_disk
 from femehl.hmatrix import FastCompliance, H2Operator, order_for
 from femehl.kernels import triangle_influence
 from femehl.presets import paper_sphere
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 @pytest.fixture(scope="module")
@@ -183,3 +187,19 @@ def test_cli_operator_flag(tmp_path, capsys):
     assert main([*argv, "--out", str(out)]) == 0
     assert (out / "summary.csv").is_file()
     assert "operator=fast" in capsys.readouterr().err
+
+
+def test_scene_file_operator(tmp_path, capsys):
+    """``[run] operator = ...`` reaches the run; a bad value is femehl's error naming the choices."""
+    from femehl.cli import main
+
+    text = (EXAMPLES / "paper_sphere.toml").read_text()
+    good = tmp_path / "fast.toml"
+    good.write_text(text.replace('mesh = "medium"', 'mesh = "coarse"\noperator = "fast"'))
+    out = tmp_path / "run"
+    assert main(["run", str(good), "--t-end", "0.03", "--quiet", "--out", str(out)]) == 0
+    assert "operator=fast" in capsys.readouterr().err
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace('mesh = "medium"', 'mesh = "coarse"\noperator = "quick"'))
+    assert main(["run", str(bad), "--t-end", "0.03", "--quiet", "--out", str(tmp_path / "b")]) != 0
+    assert "operator must be one of" in capsys.readouterr().err

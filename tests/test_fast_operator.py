@@ -50,7 +50,7 @@ def test_fast_matches_dense(sphere, half):
     Z = np.column_stack([z, smooth])
     assert _rel(fast @ Z, dense @ Z) <= 1e-6  # several columns at once
     # the near field is exact: its entries are the dense operator's
-    near = fast.H.near.tocoo()
+    near = fast.near.tocoo()
     X = np.asarray(dense @ np.eye(disc.n)[:, :1]).ravel()  # one column, cheap sanity
     assert np.all(np.isfinite(near.data)) and X.size == disc.nelements
 

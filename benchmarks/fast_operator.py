@@ -235,7 +235,8 @@ def write(rows: list[dict], agreements: list[dict], path_md: Path, path_png: Pat
             lines.append(
                 f"| {a['elements']} | {a['t_end']:g} | {a['fast_load']:.1e} | {a['fast_film_center']:.1e} | "
                 f"{a['fast_film_min']:.1e} | {a['dense_load']:.1e} | {a['dense_film_center']:.1e} | "
-                f"{a['dense_film_min']:.1e} | {a['reference_s']:.0f} | {a['dense_s']:.0f} | {a['fast_s']:.0f} |"
+                f"{a['dense_film_min']:.1e} | {a['reference_s']:.0f} | {a['dense_s']:.0f} | "
+                f"{a['fast_s']:.0f} |"
             )
         lines.append("")
     path_md.write_text("\n".join(lines) + "\n")

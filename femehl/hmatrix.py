@@ -25,11 +25,11 @@ Darve 2009, with the block partition of an H-matrix):
   leaves: ``Q`` (moments ``int_T l_b`` by a Gauss rule exact for the degree ``2 (p - 1)``)
   and ``S`` (the Lagrange basis at the centroids).
 
-``apply(u)`` is an upward pass (moments), one batched product per admissible block
-(``K`` kept with its singular values truncated at ``svd_tol`` relative to the block's
-largest), a downward pass and the sparse near field: no loop over elements or blocks in
-Python.  ``X_near`` is also what the fast path's preconditioner factors
-(:mod:`femehl.core.linsolve`).
+``X @ u`` is an upward pass (moments), one batched product per admissible block (``K``
+kept with its singular values truncated at ``svd_tol`` relative to the block's largest),
+a downward pass and the sparse near field: no loop over elements or blocks in Python.
+The near-field entries within a few element sizes are also what the fast path's
+preconditioner factors (:class:`FastCompliance`, :mod:`femehl.core.linsolve`).
 """
 
 from __future__ import annotations
@@ -209,14 +209,21 @@ class H2Operator:
     source_element : (m,) int array
         Which unknown each source triangle carries (its own element, or the element it is
         the image of): ``X u`` sums ``int_{T_j} / |c_i - x'| u[source_element[j]]``.
-    p : int
-        Chebyshev points per axis.
-    eta : float
-        Admissibility.
-    leaf : int
-        Items per leaf cluster.
-    svd_tol : float
+    n_unknowns : int
+        Length of ``u``.
+    p : int, default: 9
+        Chebyshev points per axis (:func:`order_for` gives it for a relative error).
+    eta : float, default: 2.0
+        Admissibility: ``max(diam) <= eta dist``.
+    leaf : int, default: 64
+        Items per leaf cluster (64 and eta = 2 were the fastest and smallest of the
+        tried (leaf, eta, p) = (32, 2, 9), (48, 2, 9), (32, 1.5, 8), (96, 2.5, 10) at the
+        same error).
+    svd_tol : float, default: 1e-9
         Relative singular-value truncation of the interpolated blocks.
+    keep : callable, optional
+        ``keep(i, j) -> mask`` of near-field entries (target ``i``, source ``j``) to return
+        also in :attr:`kept` as ``(rows, element columns, values)``.
     """
 
     def __init__(
@@ -230,11 +237,9 @@ class H2Operator:
         leaf=64,
         svd_tol=1e-9,
         keep=None,
-        dtype=np.float64,
     ):
         t0 = time.perf_counter()
         self.p, self.eta, self.leaf = int(p), float(eta), int(leaf)
-        self.dtype = np.dtype(dtype)  # of the far-field factors (the near field is float64)
         targets = np.asarray(targets, dtype=float)
         tri = np.asarray(tri, dtype=float)
         self.n_targets, self.n_sources = targets.shape[0], tri.shape[0]
@@ -397,7 +402,6 @@ class H2Operator:
         T, S = self.T, self.S
         order = np.argsort(ft, kind="stable")
         ft, fs = ft[order], fs[order]
-        self._far_t, self._far_s = ft, fs
         gt = _grid(T.lo[ft], T.hi[ft], nodes)  # (b, p, 2)
         gs = _grid(S.lo[fs], S.hi[fs], nodes)
         groups: dict[int, list] = {}  # rank bucket -> [(block index, U, V)] per chunk
@@ -416,8 +420,8 @@ class H2Operator:
             bucket = np.minimum(-(-r // 4) * 4, pp)  # ranks rounded up to 4: batched products
             for rb in np.unique(bucket):
                 sel = np.flatnonzero(bucket == rb)
-                Ub = (u[sel, :, :rb] * sv[sel, None, :rb]).astype(self.dtype)
-                groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].astype(self.dtype)))
+                Ub = u[sel, :, :rb] * sv[sel, None, :rb]
+                groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].copy()))
             del u, vt
         self._ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
         self._rank_mean = float(self._ranks.mean()) if self._ranks.size else 0.0
@@ -470,7 +474,7 @@ class H2Operator:
         for c, par, wx, wy in self._levels_S:  # upward: M_parent += Wx^T M_child Wy
             M[par] += np.matmul(np.matmul(wx.transpose(0, 2, 1), M[c]), wy)
         L = np.zeros((self.n_nodes_T, pp))
-        Mf = M.reshape(-1, pp).astype(self.dtype, copy=False)
+        Mf = M.reshape(-1, pp)
         for scatter, fs, U, V in self._far_groups:
             t = np.matmul(V, Mf[fs][:, :, None])
             L += scatter @ np.matmul(U, t)[:, :, 0]

@@ -45,7 +45,6 @@ def _scene():
 
 
 def case(level: float, operator: str, steps: int) -> dict:
-    import numpy as np
 
     import femehl
     from femehl.fe.fitted import fitted_disk
@@ -68,25 +67,34 @@ def case(level: float, operator: str, steps: int) -> dict:
         callback=lambda s: stamps.append((time.perf_counter(), s.info.get("krylov_iterations", 0))),
     )
     wall = time.perf_counter() - t1
-    info = res.info
-    per = np.diff([t1 + info["setup_s"]] + [t for t, _ in stamps])
-    its = [k for _, k in stamps]
     return {
         "level": level,
+        **_figures(res, [t1 + res.info["setup_s"]] + [t for t, _ in stamps], stamps, t_mesh),
         "operator": operator,
-        "elements": info["elements"],
-        "unknowns": info["unknowns"],
-        "mesh_s": t_mesh,
-        "setup_s": info["setup_s"],
-        "ms_per_step": 1e3 * float(np.mean(per[5:])),
-        "krylov_per_step": float(np.mean(its[5:])),
-        "krylov_max": int(max(its[5:])),
-        "factorizations": info["factorizations"],
-        "operator_bytes": info["operator_bytes"],
-        "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+        "factorizations": res.info["factorizations"],
         "wall_s": wall,
         "steps": steps,
-        "fast": info.get("fast_operator"),
+        "fast": res.info.get("fast_operator"),
+    }
+
+
+def _figures(res, times, stamps, t_mesh) -> dict:
+    """Per-step figures from steps 5 on (the first steps build the preconditioner)."""
+    import numpy as np
+
+    info = res.info
+    its = [k for _, k in stamps]
+    return {
+        "elements": info["elements"],
+        "unknowns": info["unknowns"],
+        "operator": info["operator"],
+        "mesh_s": t_mesh,
+        "setup_s": info["setup_s"],
+        "ms_per_step": 1e3 * float(np.mean(np.diff(times)[5:])),
+        "krylov_per_step": float(np.mean(its[5:])),
+        "krylov_max": int(max(its[5:])),
+        "operator_bytes": info["operator_bytes"],
+        "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
     }
 
 
@@ -126,8 +134,6 @@ def textured(elements: int, t_end: float, out: str) -> dict:
     """The textured example (examples/textured_sphere.py) to ``t_end``, instrumented."""
     import importlib.util
 
-    import numpy as np
-
     spec = importlib.util.spec_from_file_location(
         "textured_sphere", HERE.parent / "examples" / "textured_sphere.py"
     )
@@ -152,21 +158,9 @@ def textured(elements: int, t_end: float, out: str) -> dict:
     )
     wall = time.perf_counter() - t1
     res.save(out)  # the ParaView series of the stored steps (every 50th)
-    info = res.info
-    per = np.diff([t for t, _ in stamps])
-    its = [k for _, k in stamps]
     return {
         "kind": "textured",
-        "elements": info["elements"],
-        "unknowns": info["unknowns"],
-        "operator": info["operator"],
-        "mesh_s": t_mesh,
-        "setup_s": info["setup_s"],
-        "ms_per_step": 1e3 * float(np.mean(per[5:])),
-        "krylov_per_step": float(np.mean(its[5:])),
-        "krylov_max": int(max(its[5:])),
-        "operator_bytes": info["operator_bytes"],
-        "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+        **_figures(res, [t for t, _ in stamps], stamps, t_mesh),
         "wall_s": wall + t_mesh,
         "steps": res.nsteps,
         "t_end": float(res.t[-1]),

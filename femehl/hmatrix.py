@@ -224,6 +224,10 @@ class H2Operator:
     keep : callable, optional
         ``keep(i, j) -> mask`` of near-field entries (target ``i``, source ``j``) to return
         also in :attr:`kept` as ``(rows, element columns, values)``.
+    fold : sparse matrix (n_unknowns, m), optional
+        Act on ``z`` with ``u = fold @ z`` instead (``X fold``): the near field is stored
+        with ``fold`` multiplied in, a group of rows at a time (for the FE disk ``fold``
+        is the element average ``P`` of the P1 pressure: about half the entries).
     """
 
     def __init__(
@@ -237,6 +241,7 @@ class H2Operator:
         leaf=64,
         svd_tol=1e-9,
         keep=None,
+        fold=None,
     ):
         t0 = time.perf_counter()
         self.p, self.eta, self.leaf = int(p), float(eta), int(leaf)
@@ -245,6 +250,8 @@ class H2Operator:
         self.n_targets, self.n_sources = targets.shape[0], tri.shape[0]
         self.n_unknowns = int(n_unknowns)
         self.source_element = np.asarray(source_element)
+        self.fold = None if fold is None else sp.csr_matrix(fold)
+        self.n_cols = self.n_unknowns if fold is None else self.fold.shape[1]
         # gather the unknowns to the sources (sparse so a mirror image sums with its element)
         self.G = sp.csr_matrix(
             (np.ones(self.n_sources), (np.arange(self.n_sources), self.source_element)),
@@ -313,9 +320,8 @@ class H2Operator:
             v = pair_influence(targets[I], tri[J])
             r0 = int(T.start[bt].min())
             r1 = int((T.start[bt] + T.size[bt]).max())
-            chunks.append(
-                (r0, sp.csr_matrix((v, (row - r0, self.source_element[J])), shape=(r1 - r0, self.n_unknowns)))
-            )
+            M = sp.csr_matrix((v, (row - r0, self.source_element[J])), shape=(r1 - r0, self.n_unknowns))
+            chunks.append((r0, M if self.fold is None else (M @ self.fold).tocsr()))
             if keep is not None:
                 m = keep(I, J)
                 kept.append((I[m], self.source_element[J[m]], v[m]))
@@ -324,12 +330,12 @@ class H2Operator:
         blocks, at = [], 0
         for r0, M in chunks:
             if r0 > at:
-                blocks.append(sp.csr_matrix((r0 - at, self.n_unknowns)))
+                blocks.append(sp.csr_matrix((r0 - at, self.n_cols)))
             blocks.append(M)
             at = r0 + M.shape[0]
         if at < self.n_targets:
-            blocks.append(sp.csr_matrix((self.n_targets - at, self.n_unknowns)))
-        near = sp.vstack(blocks, format="csr") if blocks else sp.csr_matrix((self.n_targets, self.n_unknowns))
+            blocks.append(sp.csr_matrix((self.n_targets - at, self.n_cols)))
+        near = sp.vstack(blocks, format="csr") if blocks else sp.csr_matrix((self.n_targets, self.n_cols))
         if keep is None:
             return near, None
         cat = np.concatenate
@@ -347,9 +353,9 @@ class H2Operator:
         sx = _scaled(targets[:, 0], T.lo[owner, 0], T.hi[owner, 0])
         sy = _scaled(targets[:, 1], T.lo[owner, 1], T.hi[owner, 1])
         vals = (_lagrange(sx, nodes)[:, :, None] * _lagrange(sy, nodes)[:, None, :]).reshape(-1, pp)
-        cols = owner[:, None] * pp + np.arange(pp)[None, :]
+        cols = owner[:, None] * pp + np.arange(pp)[None, :]  # pp entries per row: CSR directly
         self._L2P = sp.csr_matrix(
-            (vals.ravel(), (np.repeat(np.arange(self.n_targets), pp), cols.ravel())),
+            (vals.ravel(), cols.ravel(), np.arange(0, self.n_targets * pp + 1, pp)),
             shape=(self.n_targets, T.start.size * pp),
         )
         # leaf moments Q: int_T l_b(y) dA, Gauss rule exact for degree 2 (p - 1)
@@ -371,11 +377,11 @@ class H2Operator:
             ax = ax.reshape(q.shape[0], q.shape[1], p) * w[None, :, None]
             ay = ay.reshape(q.shape[0], q.shape[1], p)
             Qv[sl] = np.einsum("eqa,eqb->eab", ax, ay).reshape(-1, pp) * area[sl, None]
-        cols = owner_s[:, None] * pp + np.arange(pp)[None, :]
-        self._P2M = sp.csr_matrix(
-            (Qv.ravel(), (cols.ravel(), np.repeat(np.arange(self.n_sources), pp))),
+        rows = owner_s[:, None] * pp + np.arange(pp)[None, :]  # pp entries per column: CSC
+        self._P2M = sp.csc_matrix(
+            (Qv.ravel(), rows.ravel(), np.arange(0, self.n_sources * pp + 1, pp)),
             shape=(S.start.size * pp, self.n_sources),
-        ).tocsr()
+        )
         # transfer matrices (1-D, per child): parent's Lagrange basis at the child's nodes
         self._levels_S = self._transfers(S, nodes)
         self._levels_T = self._transfers(T, nodes)
@@ -441,19 +447,16 @@ class H2Operator:
     @property
     def nbytes(self) -> int:
         n = 0
-        for M in (self._near_perm, self._L2P, self._P2M):
-            if M is None:  # folded into its owner's near field (FastCompliance)
-                continue
-            n += M.data.nbytes + M.indices.nbytes + M.indptr.nbytes
+        for M in (self._near_perm, self._L2P, self._P2M, self.G, self.fold):
+            if M is not None:
+                n += M.data.nbytes + M.indices.nbytes + M.indptr.nbytes
         for scatter, fs, U, V in getattr(self, "_far_groups", []):
             n += U.nbytes + V.nbytes + fs.nbytes + scatter.data.nbytes + scatter.indices.nbytes
         return int(n)
 
     @property
     def near(self):
-        """The exact near-field part (sparse, targets x unknowns, natural row order)."""
-        if self._near_perm is None:
-            raise AttributeError("the near field was folded into its owner's (FastCompliance.near)")
+        """The exact near-field part (sparse, targets x columns of ``z``, natural row order)."""
         inv = np.empty_like(self.T.perm)
         inv[self.T.perm] = np.arange(self.T.perm.size)
         return self._near_perm[inv]
@@ -463,7 +466,7 @@ class H2Operator:
         u = np.asarray(u, dtype=float)
         if u.ndim == 2:
             return np.column_stack([self @ u[:, k] for k in range(u.shape[1])])
-        y = self.far(u)
+        y = self.far(u if self.fold is None else self.fold @ u)
         y[self.T.perm] += self._near_perm @ u
         return y
 
@@ -536,20 +539,15 @@ class FastCompliance:
 
         # double precision throughout: single-precision far factors (half the memory) put a
         # rounding floor of about 1e-7 under the Krylov residual, above its rtol = 1e-8
-        self.H = H2Operator(cen, tri, src_el, ne, p=order_for(tol), svd_tol=0.1 * self.tol, keep=keep)
-        self.P = disc.P[:, disc.free].tocsr()
+        # the element average P folded into the near field: about half the entries of
+        # X_near (an element's ~800 near elements share ~400 nodes), so half the work
+        P = disc.P[:, disc.free].tocsr()
+        self.H = H2Operator(cen, tri, src_el, ne, p=order_for(tol), svd_tol=0.1 * self.tol, keep=keep, fold=P)
         self.factor = float(factor)
         rows, cols, vals = self.H.kept
         self.H.kept = None
-        self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ self.P
-        # the near field with the element average folded in: about half the entries of
-        # X_near (an element's ~800 near elements share ~400 nodes), so half the work
-        self._near_p = (self.H._near_perm @ self.P).tocsr()
-        self.H._near_perm = None
-        inv = np.empty_like(self.H.T.perm)
-        inv[self.H.T.perm] = np.arange(ne)
-        self._inv = inv
-        self.shape = (ne, self.P.shape[1])
+        self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ P
+        self.shape = (ne, P.shape[1])
         self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
 
     def __imul__(self, factor):
@@ -564,19 +562,15 @@ class FastCompliance:
     @property
     def near(self):
         """The exact near-field part of ``C / factor`` (sparse, elements x free nodes)."""
-        return self._near_p[self._inv]
+        return self.H.near
 
     @property
     def nbytes(self) -> int:
-        n = self.H.nbytes
-        for M in (self.P, self._pre, self._near_p):
-            n += M.data.nbytes + M.indices.nbytes + M.indptr.nbytes
+        n = self.H.nbytes + self._pre.data.nbytes + self._pre.indices.nbytes + self._pre.indptr.nbytes
         return int(n)
 
     def __matmul__(self, z):
         z = np.asarray(z, dtype=float)
         if z.ndim == 2:
             return np.column_stack([self @ z[:, k] for k in range(z.shape[1])])
-        y = self.H.far(self.P @ z)
-        y[self.H.T.perm] += self._near_p @ z
-        return self.factor * y
+        return self.factor * (self.H @ z)

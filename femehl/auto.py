@@ -30,11 +30,13 @@ Levels 4, 2 (pilots: cheap, their fields never written), then each next level ai
 an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
 ``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
 accepted when it is at least the third and its estimate is <= tol.  A level whose cells
-would exceed ``max_elements`` (default 25,000: about 3 GB of dense influence matrix) is
-not run: the last run is returned with ``info["auto"]["reached"] = False`` and a
-logging warning.  The companion of the returned run costs ``r**-4`` or less of it on
-the dense operator (cells ``r**2`` fewer, each step ``r**4``), so the estimate costs
-about 6 to 25 % more than the run itself; the pilots less than that.
+would exceed ``max_elements`` (default 25,000, chosen when the dense influence matrix,
+about 3 GB there, was the only operator; with the fast operator it is a cost budget,
+and a caller may raise it, e.g. ``max_elements=200_000``) is not run: the last run is
+returned with ``info["auto"]["reached"] = False`` and a logging warning.  The companion
+of the returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
+fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
+itself; the pilots less than that.
 
 Estimators (relative, one array per quantity on the returned run's ``t``)
 --------------------------------------------------------------------------

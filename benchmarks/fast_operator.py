@@ -250,6 +250,17 @@ def write(
             f"N^{fit_exponent(n, [r['operator_bytes'] for r in fast]):.2f}, peak RSS "
             f"N^{fit_exponent(n, [r['peak_rss'] for r in fast]):.2f} (N log N is about N^1.1 here)."
         )
+        big = [r for r in fast if r["elements"] >= 20_000]
+        if len(big) >= 3:
+            nb = [r["elements"] for r in big]
+            per_it = [r["ms_per_step"] / r["krylov_per_step"] for r in big]
+            per_step = fit_exponent(nb, [r["ms_per_step"] for r in big])
+            lines.append("")
+            lines.append(
+                f"From {nb[0]} elements on: time per step N^{per_step:.2f}, "
+                f"per Krylov iteration N^{fit_exponent(nb, per_it):.2f}, Krylov iterations per step "
+                f"{big[0]['krylov_per_step']:.1f} -> {big[-1]['krylov_per_step']:.1f}."
+            )
         lines.append("")
     pairs = [(d, f) for d in dense for f in fast if f["elements"] == d["elements"]]
     if pairs:

@@ -33,7 +33,7 @@ ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_TH
 
 #: fitted-mesh levels of the ladder (about 3k .. 500k half-disk elements; 0.32: the largest
 #: mesh whose dense operator fits this machine, about 29k elements)
-LEVELS = [1.0, 0.5, 0.32, 0.25, 0.177, 0.125, 0.077]
+LEVELS = [1.0, 0.5, 0.32, 0.25, 0.177, 0.125, 0.0735]
 #: the dense path is run where it fits (elements x free nodes x 8 bytes x 4 copies < 60 % RAM)
 DENSE_LEVELS = [1.0, 0.5, 0.32]
 
@@ -239,6 +239,9 @@ def write(
             f"{r['krylov_per_step']:.1f} ({r['krylov_max']}) | {r['operator_bytes'] / r['elements']:.0f} | "
             f"{r['peak_rss'] / 2**30:.2f} | {r['steps']} |"
         )
+    for r in ok:
+        if r.get("note"):
+            lines.append(f"| ({r['elements']}: {r['note']}) |  |  |  |  |  |  |  |")
     for r in rows:
         if "error" in r:
             lines.append(f"| failed | {' '.join(r['args'])} | {r['error'][-200:]!r} |  |  |  |  |  |")

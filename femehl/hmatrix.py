@@ -41,6 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .validation import check_operator_tol
+
 __all__ = ["ClusterTree", "FastCompliance", "H2Operator", "cluster_tree", "order_for", "pair_influence"]
 
 
@@ -429,8 +431,8 @@ class H2Operator:
                 Ub = u[sel, :, :rb] * sv[sel, None, :rb]
                 groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].copy()))
             del u, vt
-        self._ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
-        self._rank_mean = float(self._ranks.mean()) if self._ranks.size else 0.0
+        ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
+        self._rank_mean = float(ranks.mean()) if ranks.size else 0.0
         self._far_groups = []
         for rb in sorted(groups):
             idx = np.concatenate([g[0] for g in groups[rb]])
@@ -517,10 +519,7 @@ class FastCompliance:
     is_fast = True
 
     def __init__(self, disc, tol: float = 1e-6, factor: float = 1.0):
-        if not (isinstance(tol, (int, float)) and 1e-12 <= float(tol) < 1e-1):
-            from .errors import SceneError
-
-            raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {tol!r}.")
+        tol = check_operator_tol(tol)
         t0 = time.perf_counter()
         ne = disc.nelements
         tri = disc.tri
@@ -570,7 +569,4 @@ class FastCompliance:
         return int(n)
 
     def __matmul__(self, z):
-        z = np.asarray(z, dtype=float)
-        if z.ndim == 2:
-            return np.column_stack([self @ z[:, k] for k in range(z.shape[1])])
         return self.factor * (self.H @ z)

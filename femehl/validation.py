@@ -144,3 +144,10 @@ def call_time_function(history: str, symbol: str, f, t: float, hint: str = "") -
             "function so that it returns a finite number at every time of the run."
         ) from None
     return check_finite(f"{symbol}(t={t:g})", v, hint)
+
+
+def check_operator_tol(value) -> float:
+    """The fast elastic operator's relative error: a number in [1e-12, 0.1)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (1e-12 <= value < 0.1):
+        raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {value!r}.")
+    return float(value)

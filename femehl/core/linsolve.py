@@ -99,6 +99,10 @@ class StepOperator:
 
     def near_matrix(self):
         """Sparse CSC ``D + sum_i c_i F_i C_near`` of a fast operator: the preconditioner."""
+        return self._sparse_sum()
+
+    def _sparse_sum(self):
+        """``D + sum_i c_i (F C)_i`` with the stored sparse products, as CSC."""
         A = self.D
         for c, _, FC in self.films:
             A = A + c * FC
@@ -122,10 +126,7 @@ class StepOperator:
                 "direct solve: use linear_solver='gmres' (the default) or operator='dense'."
             )
         if not self.dense:
-            A = self.D
-            for c, _, FC in self.films:
-                A = A + c * FC
-            return sp.csc_matrix(A)
+            return self._sparse_sum()
         n = self.D.shape[0]
         A = np.empty((n, n), dtype=dtype)
         blk = max(1, (1 << 21) // max(n, 1))

@@ -26,6 +26,7 @@ from ..errors import SceneError
 from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
 from ..kernels import edge_terms, mesh_edges, triangle_influence
+from ..validation import check_operator_tol
 from . import register_method
 from ._p1p0 import P1P0
 
@@ -92,12 +93,7 @@ class FEDisc(P1P0):
         t0 = time.perf_counter()
         if not isinstance(operator, str) or operator not in OPERATORS:
             raise SceneError(f"operator must be one of {', '.join(map(repr, OPERATORS))}, got {operator!r}.")
-        if (
-            isinstance(operator_tol, bool)
-            or not isinstance(operator_tol, (int, float))
-            or not (1e-12 <= operator_tol < 0.1)
-        ):
-            raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {operator_tol!r}.")
+        operator_tol = check_operator_tol(operator_tol)
         self.scene = scene
         symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
         if half is not None and not isinstance(half, (bool, np.bool_)):
@@ -139,7 +135,7 @@ class FEDisc(P1P0):
         self.load_weights = mult * self.node_weight[self.free]
         self._finder_ = None
         self.operator = self._resolve_operator(operator, ne)
-        self.operator_tol = float(operator_tol)
+        self.operator_tol = operator_tol
         self.info = {
             "mesh": dm.name,
             "half": dm.half,
@@ -152,18 +148,10 @@ class FEDisc(P1P0):
 
     def _resolve_operator(self, operator, ne):
         """The operator to build, checked against the machine's memory."""
-        from ..fe.mesh import (
-            _OPERATOR_COPIES,
-            MEMORY_FRACTION,
-            check_mesh_memory,
-            machine_memory,
-            operator_bytes,
-        )
+        from ..fe.mesh import check_mesh_memory, dense_fits
 
         if operator == "auto":
-            memory = machine_memory()
-            fits = memory is None or _OPERATOR_COPIES * operator_bytes(ne, self.n) <= MEMORY_FRACTION * memory
-            operator = "fast" if ne >= FAST_CROSSOVER or not fits else "dense"
+            operator = "fast" if ne >= FAST_CROSSOVER or not dense_fits(ne, self.n) else "dense"
         check_mesh_memory(ne, self.n, self.dm.name, operator=operator)
         return operator
 

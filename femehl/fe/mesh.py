@@ -310,6 +310,12 @@ FAST_BYTES_PER_ELEMENT = 34_000
 FAST_MEMORY_FRACTION = 0.8
 
 
+def dense_fits(n_elements: int, n_free: int, memory: int | None = None) -> bool:
+    """True when the dense operator and its working copies fit (or the memory is unknown)."""
+    memory = machine_memory() if memory is None else memory
+    return memory is None or _OPERATOR_COPIES * operator_bytes(n_elements, n_free) <= MEMORY_FRACTION * memory
+
+
 def check_mesh_memory(
     n_elements: int, n_free: int, name: str, memory: int | None = None, operator: str = "dense"
 ) -> None:
@@ -338,7 +344,7 @@ def check_mesh_memory(
         return
     one = operator_bytes(n_elements, n_free)
     need = _OPERATOR_COPIES * one
-    if need > MEMORY_FRACTION * memory:
+    if not dense_fits(n_elements, n_free, memory):
         raise MeshError(
             f"mesh {name}: {n_elements} elements and about {n_free} free nodes need a dense elastic "
             f"operator of {_gb(one)} (elements x free nodes x 8 bytes), about {_gb(need)} with the "

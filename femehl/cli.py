@@ -82,6 +82,24 @@ def _parser():
         action="store_true",
         help="replace the run already in the output folder (its femehl files only)",
     )
+    r.add_argument(
+        "--animate",
+        action="store_true",
+        help="also write animation.gif (maps and centreline, one frame per stored step; about 1 s a frame)",
+    )
+    pl = sub.add_parser("plot", help="draw a run folder's pictures again (any stored time)")
+    pl.add_argument(
+        "what",
+        choices=["history", "maps", "animation"],
+        help="history: load, hc, V, films against t; maps: film and pressure maps; "
+        "animation: GIF of the maps",
+    )
+    pl.add_argument("folder", help="the run's output folder (femehl run --out)")
+    pl.add_argument("--t", type=float, help="maps: the stored time to draw (default: the last)")
+    pl.add_argument(
+        "--out", help="file to write (default: in the folder: history.png, maps[_tT].png, animation.gif)"
+    )
+    pl.add_argument("--fps", type=int, default=8, help="animation: frames per second (default 8)")
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument(
         "what",
@@ -184,9 +202,13 @@ def _run(args, argv=()):
         )
     except KeyboardInterrupt:
         return _interrupted(out, argv)
-    from .output.plots import FIGURES
+    from .output.plots import FIGURES, plot_animation
 
-    files = ", ".join(["fields.pvd"] + [name for name, _ in FIGURES[res.disc.dimension]])
+    names = [name for name, _ in FIGURES[res.disc.dimension]]
+    if args.animate and res.disc.dimension == 2:
+        plot_animation(out)
+        names.append("animation.gif")
+    files = ", ".join(["fields.pvd"] + names)
     print(
         f"femehl: done in {res.info['wall_s']:.1f} s ({res.info['unknowns']} unknowns, "
         f"{res.nsteps} steps); wrote {out}/summary.csv, {files}"
@@ -201,6 +223,21 @@ def _run(args, argv=()):
                 f"{_with_error(res, 'film_center', t)}, minimum film {_with_error(res, 'film_min', t)}"
             )
     return 0
+
+
+def _plot(args) -> int:
+    """``femehl plot history|maps|animation FOLDER``: the picture, from the folder's files."""
+    import time
+
+    from .output.plots import FOLDER_PLOTS
+
+    t0 = time.perf_counter()
+    if args.what != "maps" and args.t is not None:
+        raise FemehlError("--t applies to femehl plot maps only (history and animation cover every time).")
+    own = {"maps": {"t": args.t}, "animation": {"fps": args.fps}}.get(args.what, {})
+    path = FOLDER_PLOTS[args.what](args.folder, out=args.out, **own)
+    print(f"femehl: wrote {path} in {time.perf_counter() - t0:.1f} s")
+    return EXIT_DONE
 
 
 def _print_choice(res) -> None:
@@ -340,6 +377,8 @@ def main(argv=None) -> int:
         try:
             if args.command == "run":
                 return _run(args, argv)
+            if args.command == "plot":
+                return _plot(args)
             return _bench(args)
         except SolverError as exc:
             print(f"femehl: error: {exc}", file=sys.stderr)

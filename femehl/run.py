@@ -86,6 +86,18 @@ def _pictures(result: Result, folder: pathlib.Path) -> None:
         logger.warning("femehl: could not draw the PNGs in %s (%s: %s)", folder, type(exc).__name__, exc)
 
 
+def _redraw_history(folder: pathlib.Path) -> None:
+    """history.png again, now with the error estimate's band (a failure only warns)."""
+    from .output.plots import plot_history
+
+    if not (folder / "history.png").is_file():
+        return
+    try:
+        plot_history(folder)
+    except Exception as exc:  # noqa: BLE001 - pictures are a convenience
+        logger.warning("femehl: could not redraw %s/history.png (%s: %s)", folder, type(exc).__name__, exc)
+
+
 def run_to_folder(
     scene,
     folder,
@@ -277,6 +289,7 @@ def _write_estimate(folder, res) -> None:
 
     if res.estimate is not None:
         add_error_columns(folder / "summary.csv", res.estimate)
+        _redraw_history(folder)
     if "auto" in res.info:
         info = {k: v for k, v in res.info["auto"].items()}
         (folder / "auto.json").write_text(json.dumps(info, indent=1, default=float))

@@ -16,6 +16,17 @@ from femehl.output import COLUMNS
 from femehl.run import run_to_folder
 
 
+def _sources(points, n):
+    """For each written point, the computed node (one of the first ``n``) it mirrors."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(points[:n, :2])
+    img = points[n:, :2] * np.array([1.0, -1.0])
+    dist, k = tree.query(img)
+    assert np.all(dist < 1e-12) and np.all(points[n:, 1] < 0)
+    return np.concatenate([np.arange(n), k])
+
+
 def _read_csv(path):
     with open(path) as fh:
         rows = list(csv.reader(fh))
@@ -43,10 +54,16 @@ def test_run_writes_readable_series(tmp_path, method, opts):
     for s, t in zip(sets, times, strict=True):
         m = meshio.read(tmp_path / s.get("file"))
         st = res.state_at(t)
-        assert np.allclose(m.point_data["pressure"], st.p)
-        film = m.point_data["film"] if method == "fd" else m.cell_data["film"][0]
-        assert np.allclose(film, st.d)
-    for png in ("centreline.png", "fields.png"):
+        # the half disk is written mirrored: the computed nodes first, then the images of
+        # those off y = 0, each carrying the value of its source node (x, -y)
+        n = st.p.size
+        src = _sources(m.points, n)
+        assert np.allclose(m.point_data["pressure"], st.p[src])
+        if method == "fd":
+            assert np.allclose(m.point_data["film"], st.d[src])
+        else:
+            assert np.allclose(m.cell_data["film"][0], np.concatenate([st.d, st.d]))
+    for png in ("centreline.png", "maps.png", "history.png"):
         assert (tmp_path / png).stat().st_size > 10_000
 
 

@@ -220,7 +220,7 @@ def test_rupture_leaves_readable_output(out_dir):
     assert all(float(r[5]) > 0 for r in rows[1:])  # film_min column: all positive
     times = _check_series(out)
     assert times[-1] == pytest.approx(ts[-1])  # last good state written
-    for png in ("centreline.png", "fields.png"):
+    for png in ("centreline.png", "maps.png", "history.png"):
         assert (out / png).stat().st_size > 1000
     ck = load_checkpoint(out)
     assert ck.t == pytest.approx(ts[-1]) and ck.film_min > 0

@@ -107,6 +107,8 @@ class FDDisc:
     """
 
     dimension = 2
+    #: the grid is the half disk y >= 0 (outputs mirror it)
+    half = True
     default_linear_solver = "lu"
 
     def __init__(self, scene, dr: float = 0.0125, dtheta: float = math.pi / 36):

@@ -13,12 +13,26 @@ from __future__ import annotations
 import pathlib
 
 from .folder import check_folder, prepare_folder
-from .plots import centreline_png, draw_figures, line_png, profile_times, quicklook_png
+from .plots import (
+    animation_file,
+    centreline_png,
+    draw_figures,
+    history_png,
+    line_png,
+    maps_png,
+    profile_times,
+    result_table,
+)
 from .series import SeriesWriter
+from .snapshot import Snapshot, read_snapshot, snapshot
 from .table import COLUMNS, SummaryWriter, write_summary
 
 __all__ = [
     "COLUMNS",
+    "Snapshot",
+    "animation_file",
+    "history_png",
+    "maps_png",
     "RunWriter",
     "SeriesWriter",
     "SummaryWriter",
@@ -28,7 +42,9 @@ __all__ = [
     "check_folder",
     "prepare_folder",
     "profile_times",
-    "quicklook_png",
+    "result_table",
+    "read_snapshot",
+    "snapshot",
     "write_all",
     "write_summary",
 ]
@@ -71,7 +87,7 @@ class RunWriter:
 
 
 def write_all(result, folder, *, overwrite: bool = False) -> pathlib.Path:
-    """Summary CSV, centreline PNG, quick-look PNG and VTK series of a finished Result.
+    """Summary CSV, the PNGs (centreline, maps, history) and VTK series of a finished Result.
 
     The folder is checked first (:func:`~femehl.output.folder.check_folder`): a path that
     is a file or not writable, or a folder holding another run, is refused with

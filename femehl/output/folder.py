@@ -25,10 +25,14 @@ RUN_FILES = (
     "checkpoint.json",
     "centreline.png",
     "fields.png",
+    "maps.png",
+    "history.png",
+    "animation.gif",
     "line.png",
     "auto.json",
 )
 _SERIES = re.compile(r"fields_\d+\.vtu$")
+_MAPS = re.compile(r"maps_t[-+.\w]+\.png$")  # femehl plot maps RUN --t T
 _TEMPORARY = re.compile(r"(fields\.pvd|checkpoint\.npz|checkpoint\.json|fields_\d+\.vtu)\.tmp$")
 
 _FIX = (
@@ -38,7 +42,7 @@ _FIX = (
 
 
 def _is_run_file(name: str) -> bool:
-    return name in RUN_FILES or bool(_SERIES.match(name))
+    return name in RUN_FILES or bool(_SERIES.match(name)) or bool(_MAPS.match(name))
 
 
 def run_files(folder, temporary: bool = False) -> list[pathlib.Path]:

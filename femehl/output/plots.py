@@ -1,4 +1,22 @@
-"""Centreline profiles and a quick-look picture of the fields (matplotlib, Agg)."""
+"""The pictures of a run (matplotlib, Agg): history, contact maps, centreline, animation.
+
+* :func:`history_figure` (``history.png``): load, peak pressure, hc and V, central and
+  minimum film (log axis) against t, the phases of the run shaded (indentation: no
+  sliding yet; start-up: sliding, not yet steady; steady: every headline quantity within
+  :data:`STEADY_TOL` of its final value), the estimated error as a band where the run
+  carries one;
+* :func:`maps_figure` (``maps.png``): film on a logarithmic colour scale and pressure on a
+  scale centred at p = 0 (sub-ambient blue) with the p = 0 contour, over a window of
+  :data:`WINDOW` contact radii (the contact: where p > 5 % of its peak), the minimum film
+  marked; a half-disk run is shown mirrored (the whole contact);
+* :func:`centreline_png` (``centreline.png``): p and d along y = 0 at several times;
+* :func:`animation_file`: the maps and the centreline, one frame per stored time (GIF
+  through matplotlib's Pillow writer), on request only (it costs a second per frame).
+
+Every ``*_figure`` returns the matplotlib Figure (tests check its axes); ``*_png`` save it.
+The pictures of a run folder are drawn from its files (``summary.csv``, ``fields_*.vtu``),
+so ``femehl plot`` redraws them for any stored time without the run in memory.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +24,29 @@ import pathlib
 
 import numpy as np
 
-__all__ = ["centreline_png", "profile_times", "quicklook_png"]
+__all__ = [
+    "animation_file",
+    "centreline_png",
+    "history_figure",
+    "history_png",
+    "maps_figure",
+    "maps_png",
+    "phases",
+    "plot_animation",
+    "plot_history",
+    "plot_maps",
+    "profile_times",
+    "result_table",
+]
+
+#: a quantity is steady when it stays within this fraction of its final value
+STEADY_TOL = 0.01
+#: ... for at least this fraction of the run's duration
+STEADY_SPAN = 0.1
+#: the maps show this many contact radii around the origin
+WINDOW = 2.5
+#: the film map's colour scale spans from the thinnest film to this many times it
+FILM_DECADES = 10.0
 
 
 def _plt():
@@ -69,32 +109,300 @@ def centreline_png(results, path, times=None, labels=None, L=None):
     return _save(plt, fig, path, dpi=110)
 
 
-def quicklook_png(result, path, t=None):
-    """Pressure and film maps at time ``t`` (default: the last stored state)."""
+def result_table(result) -> dict:
+    """The summary columns of a Result (as in ``summary.csv``), with its error estimate.
+
+    The ``err_<name>`` columns (relative, :data:`~femehl.output.table.ERROR_COLUMNS`) are
+    the estimate interpolated to the steps; absent when the result carries none.
+    """
+    table = {k: np.asarray(v, dtype=float) for k, v in result.summary().items()}
+    est = getattr(result, "estimate", None)
+    if est is not None:
+        ts = np.asarray(est["t"], dtype=float)
+        for q in ("load", "film_center", "film_min"):
+            if q in est and est[q].get("total") is not None:
+                table[f"err_{q}"] = np.interp(table["t"], ts, est[q]["total"], left=np.nan, right=np.nan)
+    return table
+
+
+def _plateau(t, q, rel):
+    """Earliest time from which ``q`` stays within ``rel`` of its final value (or None)."""
+    q = np.asarray(q, dtype=float)
+    scale = max(abs(q[-1]), 1e-300)
+    off = np.flatnonzero(~(np.abs(q - q[-1]) <= rel * scale))
+    if off.size == 0:
+        return float(t[0])
+    return float(t[off[-1] + 1]) if off[-1] + 1 < t.size else None
+
+
+def phases(table: dict) -> list[tuple[str, float, float]]:
+    """The phases of a run from its summary columns: ``[(name, t_start, t_end)]``.
+
+    *indentation*: before the indenter slides (V = 0), if hc or the load changes there;
+    *start-up*: sliding (or, without sliding, approaching) until steady; *steady*: from
+    the first time after which V, hc, the load and the central and minimum film all stay
+    within :data:`STEADY_TOL` of their final values (hc relative to the central film),
+    if that lasts at least :data:`STEADY_SPAN` of the run.
+    """
+    t = np.asarray(table["t"], dtype=float)
+    if t.size < 2:
+        return []
+    V, hc = np.asarray(table["V"], dtype=float), np.asarray(table["hc"], dtype=float)
+    film = np.asarray(table["film_center"], dtype=float)
+    sliding = np.abs(V) > 1e-12 * max(1.0, float(np.max(np.abs(V))))
+    t_slide = float(t[np.argmax(sliding)]) if sliding.any() else None
+    starts = [_plateau(t, table[q], STEADY_TOL) for q in ("load", "film_center", "film_min")]
+    if sliding.any():
+        starts.append(_plateau(t, V, 1e-9))
+    # hc on the film's scale: the indenter is still if it moves less than 1 % of the film
+    off = np.flatnonzero(~(np.abs(hc - hc[-1]) <= STEADY_TOL * abs(film[-1])))
+    starts.append(float(t[0]) if off.size == 0 else (float(t[off[-1] + 1]) if off[-1] + 1 < t.size else None))
+    t_steady = None if any(s is None for s in starts) else max(starts)
+    if t_steady is not None and t[-1] - t_steady < STEADY_SPAN * (t[-1] - t[0]):
+        t_steady = None  # a few last steps within 1 %: drifting slowly, not steady
+    end = float(t[-1])
+    out = []
+    before = t <= (t_slide if t_slide is not None else end)
+    load = np.asarray(table["load"], dtype=float)
+    moving = np.ptp(hc[before]) > STEADY_TOL * abs(film[-1]) or np.ptp(load[before]) > STEADY_TOL * max(
+        float(np.max(np.abs(load))), 1e-300
+    )
+    if (t_slide is None or t_slide > t[0]) and moving:
+        out.append(("indentation", float(t[0]), t_slide if t_slide is not None else (t_steady or end)))
+    if t_slide is not None:
+        out.append(("start-up", t_slide, t_steady if t_steady is not None else end))
+    if t_steady is not None:
+        out.append(("steady", t_steady, end))
+    return [ph for ph in out if ph[2] > ph[1]]
+
+
+_PHASE_COLOURS = {"indentation": "#dde6f5", "start-up": "#f7e6cf", "steady": "#ddf0dd"}
+
+
+def history_figure(table: dict, title: str = ""):
+    """Load, peak pressure, hc and V, central and minimum film against t (a Figure).
+
+    ``table``: summary columns (:func:`result_table`, or
+    :func:`~femehl.output.table.read_summary` of a run folder's ``summary.csv``).
+    """
     plt = _plt()
-    state = result.state_at(result.stored_times[-1] if t is None else t)
-    L = result.scene.domain.L
-    n = 201
-    xs = np.linspace(-L, L, n)
-    ys = np.linspace(-L, L, n)
-    X, Y = np.meshgrid(xs, ys)
-    pts = np.column_stack([X.ravel(), Y.ravel()])
-    inside = np.hypot(pts[:, 0], pts[:, 1]) <= L
-    P = np.full(pts.shape[0], np.nan)
-    D = np.full(pts.shape[0], np.nan)
-    P[inside] = result.disc.pressure_at(state.p, pts[inside])
-    D[inside] = result.disc.film_at(state.d, pts[inside])
-    fig, axs = plt.subplots(1, 2, figsize=(10, 4.4))
-    for ax, F, name, cmap in ((axs[0], P, "pressure p", "viridis"), (axs[1], D, "film d", "magma")):
-        F = F.reshape(n, n)
-        if name.startswith("film"):
-            F = np.where(np.abs(X) ** 2 + np.abs(Y) ** 2 <= 1.6**2, F, np.nan)
-        im = ax.pcolormesh(X, Y, F, shading="auto", cmap=cmap)
-        fig.colorbar(im, ax=ax, shrink=0.85)
+    t = np.asarray(table["t"], dtype=float)
+    fig, axs = plt.subplots(4, 1, figsize=(7.5, 9.0), sharex=True)
+    ax_load, ax_p, ax_hc, ax_film = axs
+
+    def band(ax, name, color, label):
+        v = np.asarray(table[name], dtype=float)
+        ax.plot(t, v, color=color, label=label)
+        e = table.get(f"err_{name}")
+        if e is not None and np.any(np.isfinite(e)):
+            e = np.where(np.isfinite(e), np.abs(e), np.nan)
+            ax.fill_between(
+                t,
+                v * (1 - e),
+                v * (1 + e),
+                color=color,
+                alpha=0.25,
+                lw=0,
+                label=f"{label} +- estimated error",
+            )
+
+    band(ax_load, "load", "C0", "load")
+    ax_load.set_ylabel("load F")
+    ax_p.plot(t, table["p_max"], color="C3")
+    ax_p.set_ylabel("peak pressure")
+    ax_hc.plot(t, table["hc"], color="C2", label="hc (indenter height)")
+    ax_hc.set_ylabel("hc")
+    ax_v = ax_hc.twinx()
+    ax_v.plot(t, table["V"], color="C4", ls="--", label="V (sliding speed)")
+    ax_v.set_ylabel("V")
+    lines = ax_hc.get_lines() + ax_v.get_lines()
+    ax_hc.legend(lines, [ln.get_label() for ln in lines], fontsize=7, loc="best")
+    band(ax_film, "film_center", "C0", "central film")
+    band(ax_film, "film_min", "C1", "minimum film")
+    if np.all(np.asarray(table["film_min"]) > 0):
+        ax_film.set_yscale("log")
+    ax_film.set_ylabel("film thickness")
+    ax_film.set_xlabel("t")
+    ax_film.legend(fontsize=7, loc="best")
+    for name, a, b in phases(table):
+        for ax in axs:
+            ax.axvspan(a, b, color=_PHASE_COLOURS[name], zorder=0, lw=0)
+        ax_load.text(
+            0.5 * (a + b), 1.02, name, transform=ax_load.get_xaxis_transform(), ha="center", fontsize=8
+        )
+    ax_load.legend(fontsize=7, loc="lower right")
+    for ax in axs:
+        ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def history_png(table: dict, path, title: str = ""):
+    """:func:`history_figure` saved to ``path``."""
+    return _save(_plt(), history_figure(table, title), path, dpi=100)
+
+
+def contact_radius(snap) -> float | None:
+    """Largest distance from the origin where the pressure exceeds 5 % of its peak."""
+    p = snap.pressure
+    top = float(np.max(p)) if p.size else 0.0
+    if not np.isfinite(top) or top <= 0.0:
+        return None
+    r = np.hypot(snap.points[:, 0], snap.points[:, 1])
+    return float(np.max(r[p > 0.05 * top]))
+
+
+def _window(snap) -> float:
+    a = contact_radius(snap)
+    return snap.L if a is None else float(min(snap.L, max(WINDOW * a, 4.0 * _mesh_size(snap))))
+
+
+def _mesh_size(snap) -> float:
+    e = snap.points[snap.triangles[:, 1]] - snap.points[snap.triangles[:, 0]]
+    return float(np.median(np.hypot(e[:, 0], e[:, 1])))
+
+
+def maps_figure(snap, title: str = ""):
+    """Film (log scale) and pressure (centred at 0, with the p = 0 contour) maps of a Snapshot."""
+    import matplotlib.colors as mcolors
+    import matplotlib.tri as mtri
+
+    plt = _plt()
+    tri = mtri.Triangulation(snap.points[:, 0], snap.points[:, 1], snap.triangles)
+    W = _window(snap)
+    fig, (ax_d, ax_p) = plt.subplots(1, 2, figsize=(11, 4.8))
+    # film: logarithmic, limited to the values inside the window
+    cen = snap.points[snap.triangles].mean(axis=1)
+    inside = np.max(np.abs(cen), axis=1) <= W
+    d = snap.film
+    d_in = d[inside] if not snap.film_on_points else d[np.max(np.abs(snap.points), axis=1) <= W]
+    pos = d_in[d_in > 0]
+    if pos.size and np.all(np.isfinite(pos)):  # a decade above the thinnest film: the contact's detail
+        vmin = float(pos.min())
+        norm = mcolors.LogNorm(vmin=vmin, vmax=float(min(max(pos.max(), vmin * 1.0001), FILM_DECADES * vmin)))
+    else:
+        norm = None
+    if snap.film_on_points:
+        im = ax_d.tripcolor(
+            tri, np.maximum(d, pos.min() if pos.size else 1e-300), shading="gouraud", cmap="magma", norm=norm
+        )
+    else:
+        im = ax_d.tripcolor(
+            tri, facecolors=np.maximum(d, pos.min() if pos.size else 1e-300), cmap="magma", norm=norm
+        )
+    fig.colorbar(im, ax=ax_d, shrink=0.85, extend="max", label="film thickness d (log scale)")
+    # pressure: diverging around p = 0, so the sub-ambient region shows
+    p = snap.pressure
+    top = float(np.nanmax(np.abs(p))) or 1.0
+    lo = float(np.nanmin(p))
+    pnorm = mcolors.TwoSlopeNorm(
+        vcenter=0.0, vmin=min(lo, -1e-6 * top), vmax=max(float(np.nanmax(p)), 1e-6 * top)
+    )
+    im = ax_p.tripcolor(tri, p, shading="gouraud", cmap="RdBu_r", norm=pnorm)
+    fig.colorbar(im, ax=ax_p, shrink=0.85, label="pressure p (blue: below ambient)")
+    a = contact_radius(snap)
+    if lo < 0.0 < float(np.nanmax(p)) and a is not None:
+        # p = 0 where it bounds the loaded region (within 1.25 contact radii: farther out p is ~0
+        # everywhere and its sign is noise)
+        near = mtri.Triangulation(snap.points[:, 0], snap.points[:, 1], snap.triangles)
+        near.set_mask(np.hypot(cen[:, 0], cen[:, 1]) > 1.25 * a)
+        ax_p.tricontour(near, p, levels=[0.0], colors="k", linewidths=0.8)
+        ax_p.plot([], [], color="k", lw=0.8, label="p = 0")
+    x0, y0 = snap.film_min_at
+    xs, ys = ([x0, x0], [y0, -y0]) if snap.mirrored and abs(y0) > 0 else ([x0], [y0])
+    for ax in (ax_d, ax_p):
+        ax.plot(
+            xs, ys, marker="x", color="c", ms=9, mew=2, ls="none", label=f"minimum film {snap.film_min:.4g}"
+        )
+        ax.set_xlim(-W, W)
+        ax.set_ylim(-W, W)
         ax.set_aspect("equal")
-        ax.set_title(f"{name} at t = {state.t:g}")
-        ax.set_xlabel("x")
-    return _save(plt, fig, path, dpi=100)
+        ax.set_xlabel("x (sliding toward +x)")
+        ax.set_ylabel("y")
+        ax.legend(fontsize=7, loc="upper right")
+    mirrored = " (half disk, mirrored)" if snap.mirrored else ""
+    ax_d.set_title(f"film d at t = {snap.t:g}{mirrored}", fontsize=10)
+    ax_p.set_title(f"pressure p at t = {snap.t:g}", fontsize=10)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def maps_png(snap, path, title: str = ""):
+    """:func:`maps_figure` saved to ``path``."""
+    return _save(_plt(), maps_figure(snap, title), path, dpi=100)
+
+
+def _centreline(snap, n=401):
+    """x, p(x, 0), d(x, 0) of a Snapshot (linear interpolation; film per triangle)."""
+    import matplotlib.tri as mtri
+
+    tri = mtri.Triangulation(snap.points[:, 0], snap.points[:, 1], snap.triangles)
+    x = np.linspace(-snap.L, snap.L, n) * (1 - 1e-9)
+    y = np.full_like(x, 1e-12 * snap.L)
+    p = mtri.LinearTriInterpolator(tri, snap.pressure)(x, y).filled(np.nan)
+    if snap.film_on_points:
+        d = mtri.LinearTriInterpolator(tri, snap.film)(x, y).filled(np.nan)
+    else:
+        k = tri.get_trifinder()(x, y)
+        d = np.where(k >= 0, snap.film[np.maximum(k, 0)], np.nan)
+    return x, p, d
+
+
+def animation_file(snaps, path, fps: int = 8, title: str = ""):
+    """The film and pressure maps and the centreline, one frame per Snapshot (GIF).
+
+    ``snaps``: a list of Snapshots, or a callable ``k -> Snapshot`` with ``len`` given as
+    ``(callable, count)`` to read frames lazily.  Written through matplotlib's Pillow writer
+    to ``path`` (``.gif``).
+    """
+    import matplotlib.animation as manim
+    import matplotlib.colors as mcolors
+    import matplotlib.tri as mtri
+
+    plt = _plt()
+    get, count = snaps if isinstance(snaps, tuple) else ((lambda k: snaps[k]), len(snaps))
+    if count < 1:
+        raise ValueError("no frames")
+    last = get(count - 1)
+    W = _window(last)
+    tri = mtri.Triangulation(last.points[:, 0], last.points[:, 1], last.triangles)
+    fig, (ax_d, ax_p, ax_c) = plt.subplots(1, 3, figsize=(14, 4.4))
+    pos = last.film[last.film > 0]
+    dnorm = mcolors.LogNorm(vmin=float(pos.min()), vmax=FILM_DECADES * float(pos.min())) if pos.size else None
+    top = float(np.nanmax(np.abs(last.pressure))) or 1.0
+    pnorm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-0.5 * top, vmax=1.2 * top)
+    writer = manim.PillowWriter(fps=int(fps))
+    path = pathlib.Path(path)
+    with writer.saving(fig, str(path), dpi=80):
+        for k in range(count):
+            s = get(k) if k < count - 1 else last
+            for ax in (ax_d, ax_p, ax_c):
+                ax.clear()
+            kw = {"shading": "gouraud"} if s.film_on_points else {}
+            if s.film_on_points:
+                ax_d.tripcolor(tri, np.maximum(s.film, 1e-300), cmap="magma", norm=dnorm, **kw)
+            else:
+                ax_d.tripcolor(tri, facecolors=np.maximum(s.film, 1e-300), cmap="magma", norm=dnorm)
+            ax_p.tripcolor(tri, s.pressure, shading="gouraud", cmap="RdBu_r", norm=pnorm)
+            for ax, name in ((ax_d, "film d (log)"), (ax_p, "pressure p")):
+                ax.set_xlim(-W, W)
+                ax.set_ylim(-W, W)
+                ax.set_aspect("equal")
+                ax.set_title(f"{name}, t = {s.t:.3g}", fontsize=9)
+            x, p, d = _centreline(s)
+            ax_c.plot(x, p, color="C0", label="p")
+            ax_c.plot(x, d, color="C1", label="d")
+            ax_c.set_xlim(-W, W)
+            ax_c.set_ylim(min(-0.4 * top, 1.1 * float(np.nanmin(p))), 1.2 * top)
+            ax_c.set_title("centreline y = 0", fontsize=9)
+            ax_c.legend(fontsize=7, loc="upper right")
+            if title:
+                fig.suptitle(title, fontsize=10)
+            writer.grab_frame()
+    plt.close(fig)
+    return path
 
 
 def line_png(result, path):
@@ -118,10 +426,34 @@ def line_png(result, path):
     return _save(plt, fig, path, 110)
 
 
+def _history(result, path):
+    """A run folder's history from its summary.csv (the whole run, also when resumed), else
+    from the Result."""
+    from .table import read_summary
+
+    csv = pathlib.Path(path).parent / "summary.csv"
+    table = read_summary(csv) if csv.is_file() else result_table(result)
+    return history_png(table, path, title=_title(result))
+
+
+def _maps(result, path):
+    from .snapshot import snapshot
+
+    return maps_png(snapshot(result.disc, result.final), path, title=_title(result))
+
+
+def _title(result) -> str:
+    info = getattr(result, "info", {}) or {}
+    bits = [getattr(result, "method", "") or "", info.get("mesh", "")]
+    if info.get("elements"):
+        bits.append(f"{info['elements']} elements")
+    return ", ".join(str(b) for b in bits if b)
+
+
 #: the figures of a run folder, by the dimension of the discretization: (file name, drawer)
 FIGURES = {
-    1: (("line.png", line_png),),
-    2: (("centreline.png", centreline_png), ("fields.png", quicklook_png)),
+    1: (("line.png", line_png), ("history.png", _history)),
+    2: (("centreline.png", centreline_png), ("maps.png", _maps), ("history.png", _history)),
 }
 
 
@@ -132,3 +464,55 @@ def draw_figures(result, folder):
         draw(result, pathlib.Path(folder) / name)
         out.append(pathlib.Path(folder) / name)
     return out
+
+
+# ---- pictures of a run folder (``femehl plot``) -------------------------------------------
+def _title_of(folder) -> str:
+    return f"run folder {pathlib.Path(folder).resolve().name}"
+
+
+def plot_history(folder, out=None):
+    """``history.png`` of a run folder from its ``summary.csv`` (``out``: another file)."""
+    from .snapshot import check_run_folder
+    from .table import read_summary
+
+    folder = check_run_folder(folder)
+    table = read_summary(folder / "summary.csv")
+    if table["t"].size < 2:
+        from ..errors import OutputError
+
+        raise OutputError(f"{folder}/summary.csv has fewer than two steps: nothing to plot yet.")
+    return history_png(table, out or folder / "history.png", title=_title_of(folder))
+
+
+def maps_name(t: float | None) -> str:
+    """The file name of the maps at a stored time (``maps.png`` for the last)."""
+    return "maps.png" if t is None else f"maps_t{t:g}.png"
+
+
+def plot_maps(folder, t=None, out=None):
+    """The contact maps of a run folder at the stored time nearest ``t`` (default: the last)."""
+    from .snapshot import read_snapshot
+
+    snap = read_snapshot(folder, t)
+    name = maps_name(None if t is None else snap.t)
+    return maps_png(snap, out or pathlib.Path(folder) / name, title=_title_of(folder))
+
+
+def plot_animation(folder, out=None, fps: int = 8):
+    """``animation.gif`` of a run folder: one frame per stored field file."""
+    from ..errors import OutputError
+    from .snapshot import read_snapshot, stored_times
+
+    if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 60:
+        raise OutputError(f"fps must be an integer from 1 to 60, got {fps!r}.")
+    read_snapshot(folder)  # a run folder with a readable series (else OutputError)
+    times = [t for t, _ in stored_times(folder)]
+    frames = (lambda k: read_snapshot(folder, times[k]), len(times))
+    return animation_file(
+        frames, out or pathlib.Path(folder) / "animation.gif", fps=fps, title=_title_of(folder)
+    )
+
+
+#: ``femehl plot WHAT FOLDER``: the drawers of a run folder's pictures
+FOLDER_PLOTS = {"history": plot_history, "maps": plot_maps, "animation": plot_animation}

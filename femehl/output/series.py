@@ -5,8 +5,11 @@ small .pvd index (atomically), so an interrupted run leaves a readable
 series.  Pressure is point data; film thickness ``d``, deflection ``w`` and
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
-normalized; z = 0.  A half-disk run is written as computed (y >= 0); use
-ParaView's Reflect filter (plane Y) to see the whole contact.
+normalized; z = 0.  A half-disk run (computed on y >= 0) is written as the
+mirrored full disk (:func:`femehl.output.snapshot.mirror_half`: the nodes on
+y = 0 are shared, not duplicated), so ParaView shows the whole contact; the
+field data ``MirroredHalfDisk = 1`` says so (``mirror=False`` writes the half
+disk as computed, ``MirroredHalfDisk = 0``).
 
 Each .vtu is written atomically (temporary file + rename) and carries its time
 as ``TimeValue`` field data, so the index can be rebuilt from the files alone
@@ -25,7 +28,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-__all__ = ["SeriesWriter", "grid_cells", "read_index", "scan_series", "vtu_time"]
+__all__ = ["SeriesWriter", "field_value", "grid_cells", "read_index", "scan_series", "vtu_time"]
 
 
 def grid_cells(disc):
@@ -46,14 +49,22 @@ class SeriesWriter:
     disc : FEDisc or PolarGrid
         The discretization the states live on.
     stem : str, default: "fields"
+    mirror : bool, default: True
+        Write a half-disk run as the mirrored full disk.
     """
 
-    def __init__(self, folder, disc, stem: str = "fields"):
+    def __init__(self, folder, disc, stem: str = "fields", mirror: bool = True):
+        from .snapshot import mirror_half
+
         self.folder = pathlib.Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.disc = disc
         self.stem = stem
         self.points, self.cells, self.on_nodes = grid_cells(disc)
+        self.mirrored = bool(mirror) and bool(getattr(disc, "half", False))
+        self._source = None
+        if self.mirrored:
+            self.points, self.cells, self._source = mirror_half(self.points, self.cells)
         self.entries: list[tuple[float, str]] = []
         self.next_index = 0  # number of the next file (never one present)
 
@@ -63,13 +74,17 @@ class SeriesWriter:
 
     def write(self, state) -> pathlib.Path:
         name = f"{self.stem}_{self.next_index:06d}.vtu"
-        h = state.d + state.w
+        p, d, w = (np.asarray(a, dtype=float) for a in (state.p, state.d, state.w))
+        if self.mirrored:
+            p = p[self._source]
+            d, w = (a[self._source] if self.on_nodes else np.concatenate([a, a]) for a in (d, w))
+        h = d + w
         if self.on_nodes:
-            point_data = {"pressure": state.p, "film": state.d, "deflection": state.w, "gap": h}
+            point_data = {"pressure": p, "film": d, "deflection": w, "gap": h}
             cell_data = {}
         else:
-            point_data = {"pressure": state.p}
-            cell_data = {"film": [state.d], "deflection": [state.w], "gap": [h]}
+            point_data = {"pressure": p}
+            cell_data = {"film": [d], "deflection": [w], "gap": [h]}
         mesh = meshio.Mesh(
             self.points,
             self.cells,
@@ -80,7 +95,7 @@ class SeriesWriter:
         path = self.folder / name
         tmp = path.with_name(path.name + ".tmp")
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
-        _add_time_value(tmp, state.t)
+        _add_field_data(tmp, {"TimeValue": float(state.t), "MirroredHalfDisk": int(self.mirrored)})
         os.replace(tmp, path)
         self.next_index += 1
         self.entries.append((state.t, name))
@@ -105,13 +120,17 @@ _GRID_TAG = b"<UnstructuredGrid>"
 _TIME_RE = re.compile(rb'Name="TimeValue"[^>]*>\s*([^<\s]+)\s*<')
 
 
-def _add_time_value(path: pathlib.Path, t: float) -> None:
-    """Put ``TimeValue`` field data in a .vtu (meshio's writer leaves field data out)."""
+def _add_field_data(path: pathlib.Path, values: dict) -> None:
+    """Put scalar field data (``TimeValue`` ...) in a .vtu (meshio's writer leaves it out)."""
     data = path.read_bytes()
-    block = (
-        b'\n<FieldData>\n<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
-        b'format="ascii">' + repr(float(t)).encode() + b"</DataArray>\n</FieldData>"
+    arrays = b"".join(
+        (
+            f'<DataArray type="{"Int32" if isinstance(v, int) else "Float64"}" Name="{k}" '
+            f'NumberOfTuples="1" format="ascii">{v!r}</DataArray>\n'
+        ).encode()
+        for k, v in values.items()
     )
+    block = b"\n<FieldData>\n" + arrays + b"</FieldData>"
     i = data.find(_GRID_TAG)
     if i >= 0:
         i += len(_GRID_TAG)
@@ -133,6 +152,18 @@ def vtu_time(path) -> float | None:
     head, tail = _read_ends(pathlib.Path(path))
     m = _TIME_RE.search(head)
     if m is None or not tail.rstrip().endswith(b"</VTKFile>"):
+        return None
+    try:
+        return float(m.group(1))
+    except ValueError:
+        return None
+
+
+def field_value(path, name: str) -> float | None:
+    """A scalar field-data value (e.g. ``MirroredHalfDisk``) of a .vtu written here, or None."""
+    head, _ = _read_ends(pathlib.Path(path))
+    m = re.search(rb'Name="' + re.escape(name.encode()) + rb'"[^>]*>\s*([^<\s]+)\s*<', head)
+    if m is None:
         return None
     try:
         return float(m.group(1))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import pathlib
 
-__all__ = ["COLUMNS", "ERROR_COLUMNS", "SummaryWriter", "add_error_columns"]
+__all__ = ["COLUMNS", "ERROR_COLUMNS", "SummaryWriter", "add_error_columns", "read_summary"]
 
 COLUMNS = (
     "t",
@@ -126,3 +126,35 @@ def add_error_columns(path, estimate: dict) -> pathlib.Path:
             w.writerow([row[i] for i in keep] + cells(float(row[0])))
     tmp.replace(path)
     return path
+
+
+def read_summary(path) -> dict:
+    """The columns of a summary CSV as float arrays (empty cells: NaN); ``{}`` columns if empty.
+
+    Raises :class:`~femehl.errors.OutputError` if the file is missing, unreadable, or is
+    not a femehl summary (no ``t`` column).
+    """
+    import numpy as np
+
+    from ..errors import OutputError
+
+    path = pathlib.Path(path)
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as exc:
+        raise OutputError(f"cannot read {path} ({exc.strerror}): give the folder of a femehl run.") from None
+    except (UnicodeDecodeError, csv.Error):
+        raise OutputError(f"{path} is not a femehl summary CSV (not text).") from None
+    if not rows or rows[0][:1] != ["t"]:
+        raise OutputError(f"{path} is not a femehl summary CSV (its first column is not t).")
+    header, body = rows[0], [r for r in rows[1:] if len(r) == len(rows[0])]
+
+    def num(cell):
+        try:
+            return float(cell)
+        except ValueError:
+            return float("nan")
+
+    cols = {name: np.array([num(r[i]) for r in body], dtype=float) for i, name in enumerate(header)}
+    return cols

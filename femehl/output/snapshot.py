@@ -1,0 +1,242 @@
+"""The fields of one stored time on the whole contact, for pictures and the VTK series.
+
+A half-disk run (the indenter symmetric in y) computes y >= 0 only.  Users want to see
+the whole contact, so the series and the maps show the mirrored full disk:
+:func:`mirror_half` adds the image (x, -y) of every node off the mirror line y = 0 and
+of every cell (vertex order reversed, so the images keep their orientation); nodes *on*
+the line are their own images, so the full mesh has no duplicate points and is one
+connected mesh in ParaView.  Point fields follow the node map, cell fields are repeated.
+
+:class:`Snapshot` is what a picture needs at one time: points, triangles (quads of the
+polar grid split in two), pressure at the points, film thickness at the triangles (FE:
+element values) or at the points (FD: nodal values), and where the minimum film is.
+It is built from a :class:`~femehl.state.State` (:func:`snapshot`) or read back from a
+run folder's series (:func:`read_snapshot`), so ``femehl plot maps RUN --t 2`` draws the
+same picture as the run did.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import OutputError
+
+__all__ = ["Snapshot", "mirror_half", "read_snapshot", "snapshot", "stored_times"]
+
+#: nodes with |y| below this fraction of the mesh size are on the mirror line
+_ON_LINE = 1e-9
+
+
+def mirror_half(points, cells):
+    """The full disk of a half-disk mesh: ``(points, cells, source)``.
+
+    Parameters
+    ----------
+    points : (n, 3) array
+        Nodes of the half disk (y >= 0).
+    cells : list of (cell type, (m, k) int array)
+        Its cells.
+
+    Returns
+    -------
+    points : (n + n_off, 3) array
+        The nodes, then the images of the nodes off the line y = 0.
+    cells : list of (cell type, (2 m, k) int array)
+        The cells, then their images (vertex order reversed).
+    source : (n + n_off,) int array
+        For each full-disk node, the half-disk node whose values it carries.
+    """
+    points = np.asarray(points, dtype=float)
+    n = points.shape[0]
+    scale = float(np.max(np.abs(points[:, :2]))) if n else 1.0
+    off = np.flatnonzero(points[:, 1] > _ON_LINE * max(scale, 1e-300))
+    image = np.arange(n)
+    image[off] = n + np.arange(off.size)
+    flipped = points[off].copy()
+    flipped[:, 1] *= -1.0
+    out_cells = [(kind, np.vstack([c, image[c][:, ::-1]])) for kind, c in cells]
+    return np.vstack([points, flipped]), out_cells, np.concatenate([np.arange(n), off])
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """Fields of one time on the whole contact (normalized units)."""
+
+    t: float
+    points: np.ndarray  # (n, 2)
+    triangles: np.ndarray  # (m, 3)
+    pressure: np.ndarray  # (n,) at the points
+    film: np.ndarray  # (m,) at the triangles, or (n,) at the points
+    film_on_points: bool
+    film_min: float
+    film_min_at: tuple[float, float]
+    mirrored: bool
+    L: float
+
+    @property
+    def film_at_points(self) -> np.ndarray:
+        """The film at the points (FE element values averaged to their nodes)."""
+        if self.film_on_points:
+            return self.film
+        s = np.zeros(self.points.shape[0])
+        c = np.zeros(self.points.shape[0])
+        np.add.at(s, self.triangles.ravel(), np.repeat(self.film, 3))
+        np.add.at(c, self.triangles.ravel(), 1.0)
+        return s / np.maximum(c, 1.0)
+
+
+def _triangles(cells):
+    """Triangles of the 2-D cells (quads split along a diagonal); the cell of each triangle."""
+    tris, owner, at = [], [], 0
+    for kind, c in cells:
+        c = np.asarray(c, dtype=np.int64)
+        if kind == "triangle":
+            tris.append(c)
+            owner.append(at + np.arange(c.shape[0]))
+        elif kind == "quad":
+            tris += [c[:, [0, 1, 2]], c[:, [0, 2, 3]]]
+            owner += [at + np.arange(c.shape[0])] * 2
+        else:
+            raise OutputError(
+                f"maps need a 2-D mesh (triangles or quads), this run has {kind!r} cells: "
+                "a line-contact run has no maps; see its line.png and history.png."
+            )
+        at += c.shape[0]
+    return np.vstack(tris), np.concatenate(owner)
+
+
+def _degenerate(tris, pts):
+    """Triangles of zero area (a quad at the polar grid's centre collapses to one)."""
+    a, b, c = (pts[tris[:, k]] for k in range(3))
+    return np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])) <= 0
+
+
+def _build(t, points, cells, pressure, film, on_points, mirrored, L, film_min=None, film_min_at=None):
+    tris, owner = _triangles(cells)
+    pts = np.asarray(points, dtype=float)[:, :2]
+    keep = ~_degenerate(tris, pts)
+    tris, owner = tris[keep], owner[keep]
+    film = np.asarray(film, dtype=float)
+    film = film if on_points else film[owner]
+    if film_min is None:  # the smallest stored film value and where it is
+        k = int(np.argmin(film))
+        where = pts[k] if on_points else pts[tris[k]].mean(axis=0)
+        film_min, film_min_at = float(film[k]), (float(where[0]), float(where[1]))
+    return Snapshot(
+        float(t),
+        pts,
+        tris,
+        np.asarray(pressure, dtype=float),
+        film,
+        bool(on_points),
+        float(film_min),
+        (float(film_min_at[0]), float(film_min_at[1])),
+        bool(mirrored),
+        float(L),
+    )
+
+
+def snapshot(disc, state) -> Snapshot:
+    """The :class:`Snapshot` of ``state`` (full disk: a half-disk run is mirrored)."""
+    points, cells, on_points = disc.vtk_geometry()
+    p, d = np.asarray(state.p, dtype=float), np.asarray(state.d, dtype=float)
+    half = bool(getattr(disc, "half", False))
+    if half:
+        points, full_cells, source = mirror_half(points, cells)
+        p = p[source]
+        d = d[source] if on_points else np.concatenate([d, d])
+        cells = full_cells
+    L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
+    return _build(state.t, points, cells, p, d, on_points, half, L, state.film_min, tuple(state.film_min_at))
+
+
+# ---- reading a run folder ----------------------------------------------------------------
+def stored_times(folder) -> list[tuple[float, pathlib.Path]]:
+    """``(t, path)`` of the complete field files of a run folder, by time."""
+    from .series import scan_series
+
+    folder = pathlib.Path(folder)
+    return sorted((t, folder / name) for _, name, t in scan_series(folder) if t is not None)
+
+
+def check_run_folder(folder) -> pathlib.Path:
+    """``folder`` as a Path if it is a directory holding a femehl run (summary.csv)."""
+    folder = pathlib.Path(folder)
+    if not folder.is_dir():
+        raise OutputError(
+            f"{folder} is not a folder: give the output folder of a femehl run (--out of femehl run)."
+        )
+    if not (folder / "summary.csv").is_file():
+        raise OutputError(
+            f"{folder} holds no femehl run (no summary.csv): give the folder femehl run wrote "
+            "(default runs/<scene name>)."
+        )
+    return folder
+
+
+def read_snapshot(folder, t: float | None = None) -> Snapshot:
+    """The stored fields of a run folder nearest to time ``t`` (default: the last).
+
+    Raises :class:`~femehl.errors.OutputError` if the folder has no field series, or
+    ``t`` is more than half a storage interval from every stored time.
+    """
+    import meshio
+
+    from .table import read_summary
+
+    folder = check_run_folder(folder)
+    files = stored_times(folder)
+    if not files:
+        raise OutputError(
+            f"{folder} has no field series (fields_*.vtu): the run stored no fields "
+            "(store_every = 0); rerun with --store-every N."
+        )
+    ts = np.array([f[0] for f in files])
+    if t is None:
+        k = ts.size - 1
+    else:
+        try:
+            t = float(t)
+        except (TypeError, ValueError):
+            raise OutputError(f"t must be a number, got {t!r}.") from None
+        k = int(np.argmin(np.abs(ts - t)))
+        gap = np.min(np.diff(ts)) if ts.size > 1 else 0.0
+        if not np.isfinite(t) or abs(ts[k] - t) > max(0.5 * gap, 1e-9 * max(1.0, abs(t))):
+            raise OutputError(
+                f"no stored fields at t = {t:g} in {folder}: the series holds "
+                f"{ts.size} time(s) from {ts[0]:g} to {ts[-1]:g}; give one of them "
+                "(or rerun with a smaller --store-every)."
+            )
+    try:
+        mesh = meshio.read(files[k][1])
+    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds
+        raise OutputError(
+            f"cannot read {files[k][1]} ({type(exc).__name__}: {exc}); the file is damaged."
+        ) from None
+    cells = [(c.type, c.data) for c in mesh.cells]
+    if "pressure" not in mesh.point_data:
+        raise OutputError(f"{files[k][1]} has no pressure field: it was not written by femehl.")
+    on_points = "film" in mesh.point_data
+    film = mesh.point_data["film"] if on_points else np.concatenate(mesh.cell_data["film"])
+    mirrored = _mirrored(files[k][1])
+    L = float(np.max(np.hypot(mesh.points[:, 0], mesh.points[:, 1])))
+    fmin = None
+    where = None
+    rows = read_summary(folder / "summary.csv")
+    if rows["t"].size:  # the true minimum film (nodes and origin included) from the table
+        j = int(np.argmin(np.abs(rows["t"] - ts[k])))
+        if abs(rows["t"][j] - ts[k]) <= 1e-9 * max(1.0, abs(ts[k])):
+            fmin, where = rows["film_min"][j], (rows["film_min_x"][j], rows["film_min_y"][j])
+    return _build(
+        ts[k], mesh.points, cells, mesh.point_data["pressure"], film, on_points, mirrored, L, fmin, where
+    )
+
+
+def _mirrored(path) -> bool:
+    from .series import field_value
+
+    v = field_value(path, "MirroredHalfDisk")
+    return bool(v) if v is not None else False

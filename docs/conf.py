@@ -21,8 +21,9 @@ sys.path.insert(0, str(ROOT))  # the femehl of this checkout, before any install
 sys.path.insert(0, str(DOCS / "_ext"))
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-import femehl  # noqa: E402
 from femehl_docs import GALLERY_EXECUTED, prepare_gallery_sources  # noqa: E402
+
+import femehl  # noqa: E402
 
 project = "femehl"
 author = "the femehl authors"
@@ -71,6 +72,7 @@ sphinx_gallery_conf = {
     "filename_pattern": r"(^|[/\\])(" + "|".join(GALLERY_EXECUTED) + r")\.py$",
     "image_scrapers": ("matplotlib", "femehl_docs.written_png_scraper"),
     "reset_modules": ("matplotlib", "femehl_docs.snapshot_pngs"),
+    "reset_argv": "femehl_docs.example_argv",
     "download_all_examples": False,
     "remove_config_comments": True,
     "within_subsection_order": "FileNameSortKey",

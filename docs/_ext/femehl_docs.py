@@ -15,6 +15,7 @@ A keyword or key that has no description makes the build warn, so fails it under
 
 from __future__ import annotations
 
+import ast
 import inspect
 import shutil
 from pathlib import Path
@@ -62,6 +63,18 @@ def prepare_gallery_sources(examples: Path, target: Path) -> Path:
     return target
 
 
+def example_argv(gallery_conf, script_vars):
+    """``reset_argv`` hook: no command-line arguments, and the example's own ``__doc__``.
+
+    sphinx-gallery runs an example with ``__doc__ = ""``; the examples that build an
+    argparse parser take its description from their docstring's first line, so the real
+    docstring is put back (this hook runs once the example's globals exist).
+    """
+    src = Path(script_vars["src_file"])
+    script_vars["example_globals"]["__doc__"] = ast.get_docstring(ast.parse(src.read_text()))
+    return []
+
+
 _BEFORE: dict[Path, int] = {}
 
 
@@ -82,7 +95,7 @@ def written_png_scraper(block, block_vars, gallery_conf, **kwargs):
     folder = Path(block_vars["src_file"]).parent
     new = [p for p, t in _pngs(folder).items() if _BEFORE.get(p) != t]
     image_paths = []
-    for png, image_path in zip(new, block_vars["image_path_iterator"]):
+    for png, image_path in zip(new, block_vars["image_path_iterator"], strict=False):
         shutil.copyfile(png, image_path)
         image_paths.append(image_path)
         _BEFORE[png] = png.stat().st_mtime_ns
@@ -258,7 +271,9 @@ def _kinds(registry) -> list[tuple[str, str, str]]:
             for n, p in inspect.signature(cls).parameters.items()
         )
         summary = (inspect.getdoc(cls) or "").split("\n\n")[0].replace("\n", " ")
-        rows.append((f'``"{kind}"``', params or "(none)", f":class:`{cls.__module__}.{cls.__qualname__}`: {summary}"))
+        rows.append(
+            (f'``"{kind}"``', params or "(none)", f":class:`{cls.__module__}.{cls.__qualname__}`: {summary}")
+        )
     return rows
 
 
@@ -282,8 +297,13 @@ class TomlKeys(Directive):
             "",
         ]
         lines += _table(("kind", "keys (default)", "substrate"), _kinds(scenefile.SUBSTRATES), (14, 30, 56))
-        lines += [".. rubric:: Time functions: ``[motion.gap]``, ``[motion.velocity]``, ``[motion.load]``", ""]
-        lines += _table(("kind", "keys (default)", "function"), _kinds(scenefile.TIME_FUNCTIONS), (14, 30, 56))
+        lines += [
+            ".. rubric:: Time functions: ``[motion.gap]``, ``[motion.velocity]``, ``[motion.load]``",
+            "",
+        ]
+        lines += _table(
+            ("kind", "keys (default)", "function"), _kinds(scenefile.TIME_FUNCTIONS), (14, 30, 56)
+        )
         lines += [
             "``[fluid]`` takes only ``beta``; ``[domain]`` only ``L``.  ``[motion.load]`` may also "
             "be a plain number (a constant load).",
@@ -324,4 +344,11 @@ def setup(app):
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}
 
 
-__all__ = ["GALLERY_EXECUTED", "prepare_gallery_sources", "snapshot_pngs", "written_png_scraper", "setup"]
+__all__ = [
+    "GALLERY_EXECUTED",
+    "example_argv",
+    "prepare_gallery_sources",
+    "snapshot_pngs",
+    "written_png_scraper",
+    "setup",
+]

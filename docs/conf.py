@@ -90,3 +90,4 @@ html_theme_options = {
     "secondary_sidebar_items": ["page-toc"],
 }
 html_show_sourcelink = False
+smartquotes_action = "qe"  # no -- to en dash: CLI options stay --tol

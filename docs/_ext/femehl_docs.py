@@ -118,10 +118,15 @@ def _param_docs(obj) -> dict[str, tuple[str, str]]:
     return out
 
 
-def _default(param: inspect.Parameter) -> str:
+def _split_default(typ: str, param: inspect.Parameter) -> tuple[str, str]:
+    """(type, default): the docstring's ``default: X`` if it states one, else the signature's."""
+    head, sep, stated = typ.partition("default:")
+    if sep:
+        return head.strip().rstrip(","), stated.strip()
+    typ = typ.replace(", optional", "").strip()
     if param.default is inspect.Parameter.empty:
-        return ""
-    return f"``{param.default!r}``"
+        return typ, ""
+    return typ, f"``{param.default!r}``"
 
 
 def _row(cells) -> list[str]:
@@ -189,7 +194,8 @@ class SolveOptions(Directive):
                         f"femehl-solve-options: {owner}: keyword {name!r} has no description",
                         location=self.state_machine.get_source_and_line(self.lineno),
                     )
-                rows.append((f"``{name}``", typ, _default(param), desc))
+                typ, default = _split_default(typ, param)
+                rows.append((f"``{name}``", typ, default, desc))
             groups.append((title, owner, rows))
 
         group("The run", "femehl.solve", api.solve, skip={"scene"})
@@ -247,19 +253,8 @@ RUN_KEY_DOCS = {
     "grading": ("line ``grading``", '"uniform" or a size ratio >= 1'),
 }
 
-SI_KEYS = {
-    "R": "radius of curvature of the indenter [m] (the normalizing length)",
-    "G": "shear modulus of the substrate [Pa]",
-    "eta": "viscosity of the fluid [Pa s]",
-    "V_ss": "steady sliding speed [m/s]",
-    "h_inf": "film thickness scale [m]",
-    "nu": "Poisson ratio (optional, default 0.5)",
-    "h0": "initial tip clearance (normalized by h_inf, > 0)",
-    "t1": "end of the gap ramp and start of sliding (optional)",
-    "T": "sliding start-up time constant (optional)",
-    "L": "domain radius (normalized, optional, default 2)",
-    "load": "imposed constant load [N] instead of the gap ramp (optional)",
-}
+#: the [si] key the Python API has no parameter for
+SI_LOAD = ("load", "float", "Imposed constant load [N] instead of the gap ramp (optional).")
 
 
 def _kinds(registry) -> list[tuple[str, str, str]]:
@@ -326,12 +321,24 @@ class TomlKeys(Directive):
                 where.append("line")
             rows.append((f"``{key}``", " and ".join(where), same, desc))
         lines += _table(("key", "scenes", "same as", "meaning"), rows, (18, 14, 28, 40))
-        lines += [".. rubric:: ``[si]`` keys (the paper's experiment in SI units)", ""]
-        lines += _table(("key", "meaning"), [(f"``{k}``", v) for k, v in SI_KEYS.items()], (15, 85))
+        lines += [
+            ".. rubric:: ``[si]`` keys (the paper's experiment in SI units)",
+            "",
+            "The parameters of :class:`femehl.scene.Dimensional` and of its "
+            ":meth:`~femehl.scene.Dimensional.scene`, and ``load``:",
+            "",
+        ]
+        from femehl.scene import Dimensional
+
+        si = {**_param_docs(Dimensional), **_param_docs(Dimensional.scene)}
+        rows = [(f"``{k}``", typ, desc) for k, (typ, desc) in si.items()]
+        rows.append((f"``{SI_LOAD[0]}``", SI_LOAD[1], SI_LOAD[2]))
+        lines += _table(("key", "type", "meaning"), rows, (15, 25, 60))
         return _parse(self, lines)
 
 
 def _parse(directive, lines):
+    directive.state.document.settings.env.note_reread()  # the tables follow the code, not the page
     node = nodes.container()
     source, _ = directive.state_machine.get_source_and_line(directive.lineno)
     directive.state.nested_parse(StringList(lines, source=source), directive.content_offset, node)

@@ -486,6 +486,12 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     params : dict
         The indenter's parameters in metres.
     dim : femehl.scene.Dimensional
+        The experiment whose scales normalize them.
+
+    Returns
+    -------
+    Indenter
+        An instance of ``INDENTERS[kind]`` in normalized units.
     """
     if kind not in INDENTERS:
         raise SceneError(f"indenter kind {kind!r} is not known; use one of {sorted(INDENTERS)}.")

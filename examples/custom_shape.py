@@ -1,4 +1,7 @@
-"""A user-defined indenter from a Python function: a sphere with an oblique ripple.
+"""A user-defined indenter: a sphere with an oblique ripple
+========================================================
+
+A user-defined indenter from a Python function: a sphere with an oblique ripple.
 
 Any vectorized function s(x, y) >= 0 with s(0, 0) = 0 can be the indenter's gap.
 Here a sphere carries a sinusoidal ripple whose crests run at 30 degrees to the sliding

@@ -1,4 +1,7 @@
-"""Transient sliding of a rigid cylinder on a lubricated Winkler foundation (paper section 4).
+"""Line contact: a cylinder sliding on a Winkler foundation
+========================================================
+
+Transient sliding of a rigid cylinder on a lubricated Winkler foundation (paper section 4).
 
 The cylinder (gap x^2/2) is pushed from hc = 0.1 to hc = h_end over 0 <= t <= 1
 (pure squeeze), then slides with V = tanh(t - 1).  At long times the film

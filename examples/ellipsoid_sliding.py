@@ -1,4 +1,7 @@
-"""An elliptic contact sliding along x, its long axis across the sliding direction.
+"""An elliptic contact sliding across its long axis
+================================================
+
+An elliptic contact sliding along x, its long axis across the sliding direction.
 
 The indenter is an elliptic paraboloid s = x^2/(2 Rx) + y^2/(2 Ry) with Rx = 0.5 < Ry = 2:
 the dry contact is an ellipse elongated along y, across the sliding direction +x (like a

@@ -1,4 +1,7 @@
-"""Load-controlled approach: the paper's sphere pressed by a constant load instead of a gap ramp.
+"""Load-controlled approach of the paper's sphere
+==============================================
+
+Load-controlled approach: the paper's sphere pressed by a constant load instead of a gap ramp.
 
 The load F = 4/(3 pi) (the normalized Hertz load of an indentation hc = -1) is applied
 at t = 0 to the paper's sphere (beta = 200, hc(0) = 0.1, incompressible half space).

@@ -1,4 +1,7 @@
-"""Reproduce the paper's Figs. 5-7 (Wu, Hui et al. 2022) with both femehl solvers on one plot.
+"""The paper's Figs. 5-7 with both solvers
+=======================================
+
+Reproduce the paper's Figs. 5-7 (Wu, Hui et al. 2022) with both femehl solvers on one plot.
 
 Centreline (y = 0) pressure and film thickness of the paper case (beta = 200,
 h0 = 0.1):

@@ -1,4 +1,7 @@
-"""A textured sphere sliding on the full disk: a square array of shallow dimples, 200k elements.
+"""A textured sphere: 200,000 elements on the fast operator
+========================================================
+
+A textured sphere sliding on the full disk: a square array of shallow dimples, 200k elements.
 
 Surface texturing (laser-made dimples) is the application the paper names for its scheme.
 Here the sphere carries a square array of smooth dimples of depth ``DEPTH`` (in units of

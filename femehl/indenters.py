@@ -18,17 +18,17 @@ paper's sphere.  :data:`INDENTERS` maps the scene-file names to the classes;
 
 Shapes
 ------
-================  ==========================================================
-``Sphere(R)``      ``s = (x^2 + y^2) / (2 R)`` (the paraboloid of the tip)
-``Ellipsoid(Rx,    ``s = x^2/(2 Rx) + y^2/(2 Ry)`` (elliptic paraboloid); the
-Ry)``              indenter slides along x, so ``Rx < Ry`` puts the long
-                   axis of the contact across the sliding direction
-``FlatPunch(a,     flat for ``r < a``, then ``s = (r - a)^2 / (2 edge_radius)``
-edge_radius)``     (a C1 rounded edge)
-``Shape(func)``    any user callable ``func(x, y)`` on numpy arrays
-``HeightMap(x, y,  samples ``z[i, j] = s(x[i], y[j])`` on a regular grid,
-z)``               interpolated bilinearly; must cover the disk ``r <= L``
-================  ==========================================================
+=============================  ============================================================
+``Sphere(R)``                  ``s = (x^2 + y^2) / (2 R)`` (the paraboloid of the tip)
+``Ellipsoid(Rx, Ry)``          ``s = x^2/(2 Rx) + y^2/(2 Ry)`` (elliptic paraboloid); the
+                               indenter slides along x, so ``Rx < Ry`` puts the long
+                               axis of the contact across the sliding direction
+``FlatPunch(a, edge_radius)``  flat for ``r < a``, then ``s = (r - a)^2 / (2 edge_radius)``
+                               (a C1 rounded edge)
+``Shape(func)``                any user callable ``func(x, y)`` on numpy arrays
+``HeightMap(x, y, z)``         samples ``z[i, j] = s(x[i], y[j])`` on a regular grid,
+                               interpolated bilinearly; must cover the disk ``r <= L``
+=============================  ============================================================
 """
 
 from __future__ import annotations
@@ -321,7 +321,7 @@ class HeightMap:
         (x, y) = (0, 0).
     symmetric_y : bool, optional
         Whether ``s(x, -y) = s(x, y)``.  Default: detected from the data (the
-        y grid symmetric about 0 and ``z[:, ::-1] == z`` to 1e-12 of max |z|).
+        y grid symmetric about 0 and ``z[:, ::-1] == z`` to 1e-12 of max ``|z|``).
 
     Notes
     -----
@@ -486,6 +486,12 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     params : dict
         The indenter's parameters in metres.
     dim : femehl.scene.Dimensional
+        The experiment whose scales normalize them.
+
+    Returns
+    -------
+    Indenter
+        An instance of ``INDENTERS[kind]`` in normalized units.
     """
     if kind not in INDENTERS:
         raise SceneError(f"indenter kind {kind!r} is not known; use one of {sorted(INDENTERS)}.")

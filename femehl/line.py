@@ -22,7 +22,7 @@ steady sliding solution, which :mod:`femehl.line_steady` computes by
 quadrature and shooting.
 
 The scheme (paper section 3, femehl's FE form, docs/design.md, section 4)
-------------------------------------------------------------------
+-------------------------------------------------------------------------
 P1 pressure on a scikit-fem :class:`~skfem.MeshLine` (uniform or graded),
 the film on elements (P0): ``d_e = h(x_e) + (P p)_e / k`` with ``x_e`` the
 centroid and ``P`` the element average of a P1 field.  With ``d^3`` lagged

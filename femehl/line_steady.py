@@ -200,6 +200,7 @@ def steady_line(
     x : array_like, optional
         Where to return d and p; default ``n`` equally spaced points on [-L, L].
     n : int, default: 2001
+        Number of points of the default ``x``.
     method : {"LSODA", "Radau", "BDF"}, default: "LSODA"
         Stiff integrator of :func:`scipy.integrate.solve_ivp`.
     rtol : float, default: 1e-12
@@ -209,7 +210,10 @@ def steady_line(
 
     Returns
     -------
-    (x, d, p, d_star) : tuple of arrays and float, or SteadyLine when ``full``
+    x, d, p, d_star : ndarray, ndarray, ndarray, float
+        The points, the film thickness and the pressure there, and the film thickness
+        where the pressure gradient vanishes; when ``full``, the :class:`SteadyLine`
+        instead.
     """
     k, beta, hc, L, V = _check(k, beta, hc, L, V, method)
     sl = _solve(k, beta, hc, L, V, method, rtol)

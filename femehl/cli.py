@@ -187,6 +187,8 @@ def _run(args, argv=()):
         run.setdefault("dr", 0.0125)
         run.setdefault("dtheta", math.pi / 36)
     out = args.out or f"{DEFAULT_OUT}/{name}"
+    if args.animate and run.get("store_every", 10) == 0:
+        raise FemehlError("--animate draws the stored fields: drop --store-every 0 (or store_every = 0).")
     try:
         res = run_to_folder(
             scene,

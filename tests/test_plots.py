@@ -206,6 +206,9 @@ def test_cli_plot_commands(run, tmp_path, capsys):
 
     frames = len(list(folder.glob("fields_*.vtu")))
     assert Image.open(tmp_path / "a.gif").n_frames == frames
+    # the figure sizes the code sets (inches x dpi): history 7.5 x 9 at 100, maps 11 x 4.8 at 100
+    assert Image.open(tmp_path / "h.png").size == (750, 900)
+    assert Image.open(tmp_path / "m.png").size == (1100, 480)
     assert "femehl: wrote" in capsys.readouterr().out
 
 
@@ -253,3 +256,18 @@ def test_line_contact_history_and_no_maps(tmp_path):
     assert (tmp_path / "history.png").stat().st_size > 10_000
     with pytest.raises(OutputError, match="line-contact run has no maps"):
         plots.plot_maps(tmp_path)
+
+
+def test_cli_animate_needs_stored_fields(tmp_path, capsys):
+    argv = ["run", "--mesh", "coarse", "--dt", "0.1", "--t-end", "0.2", "--store-every", "0", "--animate"]
+    assert main([*argv, "--out", str(tmp_path / "r"), "--quiet"]) == 2
+    assert "drop --store-every 0" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()  # refused before anything is written
+
+
+def test_cli_run_animate(tmp_path):
+    argv = ["run", "--mesh", "coarse", "--dt", "0.1", "--t-end", "0.4", "--store-every", "2", "--animate"]
+    assert main([*argv, "--out", str(tmp_path), "--quiet"]) == 0
+    from PIL import Image
+
+    assert Image.open(tmp_path / "animation.gif").n_frames == 3  # t = 0, 0.2, 0.4

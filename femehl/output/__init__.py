@@ -25,7 +25,7 @@ from .plots import (
 )
 from .series import SeriesWriter
 from .snapshot import Snapshot, read_snapshot, snapshot
-from .table import COLUMNS, SummaryWriter, write_summary
+from .table import COLUMNS, SummaryWriter, add_error_columns, write_summary
 
 __all__ = [
     "COLUMNS",
@@ -96,6 +96,8 @@ def write_all(result, folder, *, overwrite: bool = False) -> pathlib.Path:
     folder = check_folder(folder, overwrite=overwrite)
     prepare_folder(folder, overwrite=overwrite)
     write_summary(result, folder / "summary.csv")
+    if getattr(result, "estimate", None) is not None:
+        add_error_columns(folder / "summary.csv", result.estimate)
     series = SeriesWriter(folder, result.disc)
     for s in result.states:
         series.write(s)

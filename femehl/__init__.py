@@ -42,10 +42,12 @@ from .scene import (
     Winkler,
 )
 from .stepping import State, march
+from .sweeps import sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "sweep",
     "presets",
     "auto",
     "indenters",

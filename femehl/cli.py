@@ -100,6 +100,24 @@ def _parser():
         "--out", help="file to write (default: in the folder: history.png, maps[_tT].png, animation.gif)"
     )
     pl.add_argument("--fps", type=int, default=8, help="animation: frames per second (default 8)")
+    sw = sub.add_parser(
+        "sweep",
+        help="a parameter study on a Dask cluster: femehl sweep SWEEP.toml, femehl sweep plot OUT",
+    )
+    sw.add_argument(
+        "args", nargs="+", metavar="SWEEP.toml | plot OUT", help="a sweep file, or plot and its output folder"
+    )
+    sw.add_argument("--scheduler", help="address of an existing Dask scheduler (default: a local cluster)")
+    sw.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
+    sw.add_argument(
+        "--memory-limit", help="local cluster: memory per worker, e.g. 4GiB (default: a share of RAM)"
+    )
+    sw.add_argument(
+        "--overwrite", action="store_true", help="replace another sweep's table in the output folder"
+    )
+    sw.add_argument("--retry-failed", action="store_true", help="run the cases recorded as failed again")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.add_argument("--x", help="plot: the parameter on the x axis (default: the first swept number)")
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument(
         "what",
@@ -242,6 +260,45 @@ def _plot(args) -> int:
     return EXIT_DONE
 
 
+def _sweep(args) -> int:
+    """``femehl sweep SWEEP.toml`` (run) or ``femehl sweep plot OUT`` (master curves)."""
+    from . import sweeps as sw
+
+    if args.args[0] == "plot":
+        if len(args.args) != 2:
+            raise FemehlError("femehl sweep plot takes one output folder: femehl sweep plot OUT.")
+        from .sweep_plot import plot_master_curves
+
+        png, fits = plot_master_curves(args.args[1], x=args.x)
+        for line in fits:
+            print(line)
+        print(f"femehl: wrote {png}")
+        return EXIT_DONE
+    if len(args.args) != 1:
+        raise FemehlError("femehl sweep takes one sweep file (or: femehl sweep plot OUT).")
+    plan = sw.load_sweep_file(args.args[0])
+    cluster = plan.spec.get("cluster", {})
+    table = sw.sweep(
+        plan=plan,
+        scheduler=args.scheduler or cluster.get("scheduler"),
+        workers=args.workers or cluster.get("workers"),
+        memory_limit=args.memory_limit or cluster.get("memory_limit"),
+        overwrite=args.overwrite,
+        retry_failed=args.retry_failed,
+        progress=not args.quiet,
+    )
+    info = table.attrs["sweep"]
+    status = table.drop_duplicates("case")["status"].value_counts().to_dict()
+    eff = info["cases_s"] / info["wall_s"] if info["wall_s"] > 0 and info["ran"] else float("nan")
+    print(
+        f"femehl: sweep of {len(plan.cases)} cases ({info['ran']} run, {info['skipped']} finished before): "
+        + ", ".join(f"{v} {k}" for k, v in sorted(status.items()))
+        + f"; {info['wall_s']:.1f} s wall for {info['cases_s']:.1f} s of cases "
+        f"({eff:.2f} cases running on average); wrote {plan.out}/results.parquet"
+    )
+    return EXIT_DONE
+
+
 def _print_choice(res) -> None:
     """What an automatic run chose, and its estimated error."""
     a = res.info.get("auto")
@@ -381,6 +438,8 @@ def main(argv=None) -> int:
                 return _run(args, argv)
             if args.command == "plot":
                 return _plot(args)
+            if args.command == "sweep":
+                return _sweep(args)
             return _bench(args)
         except SolverError as exc:
             print(f"femehl: error: {exc}", file=sys.stderr)

@@ -76,6 +76,7 @@ __all__ = [
     "SUBSTRATES",
     "TIME_FUNCTIONS",
     "load_scene_file",
+    "scene_from_mapping",
 ]
 
 from .substrates import SUBSTRATES  # noqa: E402  (kind -> class, filled by the substrates)
@@ -178,6 +179,19 @@ def load_scene_file(path) -> tuple[Scene, dict]:
         raise SceneFileError(f"cannot read scene file {str(path)!r}: {exc}.") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneFileError(f"{path}: not valid TOML ({exc}); see examples/paper_sphere.toml.") from None
+    return scene_from_mapping(raw, path)
+
+
+def scene_from_mapping(raw: dict, path) -> tuple:
+    """``(scene, run_options)`` of a scene file's content already read (a dict of tables).
+
+    ``path`` names the file in messages and anchors its relative paths (height maps,
+    mesh files); see :func:`load_scene_file`.  ``raw`` is not modified.
+    """
+    import copy
+
+    path = pathlib.Path(path)
+    raw = copy.deepcopy(raw)
     known = {"indenter", "substrate", "fluid", "motion", "domain", "run", "si"}
     unknown = set(raw) - known
     if unknown:

@@ -291,3 +291,28 @@ def test_mesh_fitted_is_a_solver_option():
     st = femehl.make_stepper(femehl.presets.paper_sphere(), mesh="fitted")
     assert st.info["mesh"].startswith("fitted-") and st.info["half"]
     assert abs(st.info["elements"] / 2982 - 1.0) < 0.05
+
+
+def test_wide_exit_zone_of_an_ellipse_keeps_sizes_positive(tmp_path):
+    """At small beta the exit zone is wide, and along the long axis of an ellipse the edge
+    size can exceed the contact size: the band must then grow away from the edge (it used
+    to shrink to zero there: 7.7e8 elements estimated for Rx = 1, Ry = 2, beta = 20)."""
+    sc = Scene(
+        indenter=Ellipsoid(1.0, 2.0),
+        fluid=femehl.Fluid(beta=20.0),
+        motion=Motion(gap=RampHold(0.1, -1.0, 1.0), velocity=TanhStart(1.0, 1.0)),
+        domain=Domain(3.0),
+    )
+    sz = fitted_sizes(sc, 8.0)
+    ax, ay = contact_extent(sc, 8.0)
+    assert sz.edge_coef * max(ax, ay) > sz.h_contact  # the case this test is about
+    r, th = np.meshgrid(np.linspace(0, 3.0, 301), np.linspace(0, math.pi, 91))
+    h = np.array(
+        [sz.size(x, y) for x, y in zip((r * np.cos(th)).ravel(), (r * np.sin(th)).ravel(), strict=True)]
+    )
+    assert h.min() >= min(sz.h_contact, sz.edge_coef * min(ax, ay)) * (1 - 1e-12)
+    # about as many elements as the sphere of the same depth (the ellipse is 1.6 times larger)
+    sphere = fitted_sizes(Scene(fluid=femehl.Fluid(beta=20.0), motion=sc.motion, domain=Domain(3.0)), 8.0)
+    assert sz.estimate_elements(True) < 3 * sphere.estimate_elements(True)
+    dm = fitted_disk(sc, 8.0, cache_dir=tmp_path)
+    assert dm.mesh.t.shape[1] < 2 * sz.estimate_elements(True)

@@ -411,7 +411,9 @@ class FittedSizes:
         h_c = self.h_contact
         h_e = self.edge_coef * ell
         dn = abs(rho - 1.0) * ell
-        band = h_e + (h_c - h_e) * max(dn - self.width * ell, 0.0) / (TRANSITION * ell)
+        # from h_e at the edge toward h_c, growing beyond it (zone then rules); an edge size
+        # above the contact size (wide exit zones at small beta, ellipses) grows from h_e
+        band = h_e + abs(h_c - h_e) * max(dn - self.width * ell, 0.0) / (TRANSITION * ell)
         if rho <= RHO_CONTACT:
             zone = h_c
         else:
@@ -444,6 +446,8 @@ class FittedSizes:
             version=FITTED_VERSION,
             consts=[C_CONTACT, C_EDGE, TRANSITION, RHO_CONTACT],
         )
+        if self.edge_coef * max(self.ax, self.ay) > self.h_contact:
+            d["edge_band"] = 2  # the band grows from h_e (before: it shrank, down to 0)
         return d
 
 

@@ -85,7 +85,8 @@ def _parser():
     r.add_argument(
         "--animate",
         action="store_true",
-        help="also write animation.gif (maps and centreline, one frame per stored step; about 1 s a frame)",
+        help="also write animation.gif (maps and centreline, one frame per stored step; "
+        "0.16 s a frame on the coarse mesh)",
     )
     pl = sub.add_parser("plot", help="draw a run folder's pictures again (any stored time)")
     pl.add_argument(

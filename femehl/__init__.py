@@ -43,10 +43,13 @@ from .scene import (
 )
 from .stepping import State, march
 from .sweeps import sweep
+from .viscosity import Barus, Roelands
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Barus",
+    "Roelands",
     "sweep",
     "presets",
     "auto",

@@ -105,6 +105,8 @@ class LineScene(SceneEffects):
     load : callable or float or None, default: None
         Imposed load per unit length ``F(t) = int p dx``; None imposes the gap
         instead.  ``motion.load`` is accepted too (and moved here); give one of them.
+    viscosity : femehl.Barus or femehl.Roelands, optional
+        Pressure-dependent viscosity (:mod:`femehl.viscosity`); None: isoviscous.
     """
 
     default_method = "line"
@@ -114,8 +116,12 @@ class LineScene(SceneEffects):
     motion: Motion = field(default_factory=_default_motion)
     L: float = 2.0
     load: Callable[[float], float] | None = None
+    viscosity: object = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from .viscosity import check_viscosity
+
+        check_viscosity(self.viscosity)
         object.__setattr__(
             self,
             "k",

@@ -223,11 +223,19 @@ def _as_time_function(name: str, f) -> Callable[[float], float]:
 # --------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Fluid:
-    """The film's Newtonian fluid, through the paper's ``beta`` (Eq. 10e)."""
+    """The film's fluid, through the paper's ``beta`` (Eq. 10e) at the ambient viscosity.
+
+    ``viscosity``: None (isoviscous, the paper's) or a pressure-viscosity model,
+    :class:`femehl.Barus` or :class:`femehl.Roelands` (:mod:`femehl.viscosity`), lagged one
+    step in the Poiseuille flux.
+    """
 
     beta: float = 200.0
+    viscosity: object = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from .viscosity import check_viscosity
+
         object.__setattr__(
             self,
             "beta",
@@ -237,6 +245,7 @@ class Fluid:
                 "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss); use Dimensional(...) to compute it.",
             ),
         )
+        check_viscosity(self.viscosity)
 
 
 @dataclass(frozen=True)
@@ -365,6 +374,11 @@ class Scene(SceneEffects):
     fluid: Fluid = field(default_factory=Fluid)
     motion: Motion = field(default_factory=Motion)
     domain: Domain = field(default_factory=Domain)
+
+    @property
+    def viscosity(self):
+        """The fluid's pressure-viscosity model (None: isoviscous)."""
+        return self.fluid.viscosity
 
     def __post_init__(self):
         for name, cls in (("fluid", Fluid), ("motion", Motion), ("domain", Domain)):

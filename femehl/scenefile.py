@@ -10,6 +10,8 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           | "cylinder" (R = 1 only): line contact, see below
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
     [fluid]               beta = 200.0
+    [fluid.viscosity]     optional: kind = "barus" (alpha) | "roelands" (alpha, p_r, Z),
+                          normalized (see femehl.viscosity); isoviscous without it
     [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)
                           | "table" (times = [...], values = [...])
     [motion.velocity]     kind = "tanh" (t1, T, V_ss) | "constant" | "table"
@@ -302,9 +304,7 @@ def _si_scene(raw, path):
 def _normalized_scene(raw, path):
     indenter = _build(INDENTERS, raw.get("indenter", {"kind": "sphere"}), "indenter", path)
     substrate = _build(SUBSTRATES, raw.get("substrate", {"kind": "halfspace"}), "substrate", path)
-    fluid = raw.get("fluid", {})
-    if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
-        raise SceneFileError(f"{path}: [fluid] takes only beta.")
+    fluid = _fluid(raw, path)
     motion = _motion(raw, path)
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
@@ -312,6 +312,19 @@ def _normalized_scene(raw, path):
     return Scene(
         indenter=indenter, substrate=substrate, fluid=Fluid(**fluid), motion=motion, domain=Domain(**domain)
     )
+
+
+def _fluid(raw, path) -> dict:
+    """[fluid] beta and [fluid.viscosity] (kind = "barus" | "roelands", see femehl.viscosity)."""
+    from .viscosity import VISCOSITY_MODELS
+
+    fluid = raw.get("fluid", {})
+    if not isinstance(fluid, dict) or set(fluid) - {"beta", "viscosity"}:
+        raise SceneFileError(f"{path}: [fluid] takes beta and a [fluid.viscosity] table only.")
+    fluid = dict(fluid)
+    if "viscosity" in fluid:
+        fluid["viscosity"] = _build(VISCOSITY_MODELS, fluid["viscosity"], "fluid.viscosity", path)
+    return fluid
 
 
 def _motion(raw, path) -> Motion:
@@ -370,16 +383,13 @@ def _line_scene(raw, path):
             'or use a 3-D indenter (e.g. kind = "sphere") for other substrates.'
         )
     winkler = _build(SUBSTRATES, sub, "substrate", path)
-    fluid = raw.get("fluid", {})
-    if not isinstance(fluid, dict) or set(fluid) - {"beta"}:
-        raise SceneFileError(f"{path}: [fluid] takes only beta.")
+    fluid = _fluid(raw, path)
     motion = _motion(raw, path)
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
     kw = {"k": winkler.k, "motion": motion}
-    if "beta" in fluid:
-        kw["beta"] = fluid["beta"]
+    kw.update({k: fluid[k] for k in ("beta", "viscosity") if k in fluid})
     if "L" in domain:
         kw["L"] = domain["L"]
     try:

@@ -132,6 +132,8 @@ class Mobility(Protocol):
 class Newtonian:
     """``m = d^3``: a Newtonian film with no slip (the paper's Eq. 8)."""
 
+    uses_pressure = False
+
     def value(self, d, p_film=None):
         return d**3
 
@@ -142,12 +144,18 @@ class Newtonian:
 # ---- the paper's three terms --------------------------------------------------------------
 @register_term
 class Poiseuille:
-    """Pressure-driven flux ``beta div(m grad p)``, ``m`` lagged: ``beta D(m(d^*)) p``."""
+    """Pressure-driven flux ``beta div(m grad p)``, ``m`` lagged: ``beta D(m(d^*, p^k)) p``.
+
+    The mobility is ``mobility`` if given, else the scene's: ``d^3`` (Newtonian), or
+    ``d^3 / r(p^k)`` when the scene has a pressure-dependent viscosity
+    (:class:`femehl.viscosity.PiezoviscousMobility`; ``p^k`` averaged to the film points
+    by ``disc.average()``).
+    """
 
     name = "poiseuille"
 
     def __init__(self, mobility: Mobility | None = None):
-        self.mobility = Newtonian() if mobility is None else mobility
+        self.mobility = mobility
 
     @staticmethod
     def applies(scene, t_end=None):
@@ -155,10 +163,20 @@ class Poiseuille:
 
     def setup(self, disc):
         self.disc = disc
+        if self.mobility is None:
+            model = getattr(disc.scene, "viscosity", None)
+            if model is None:
+                self.mobility = Newtonian()
+            else:
+                from ..viscosity import PiezoviscousMobility
+
+                self.mobility = PiezoviscousMobility(model)
+        self._average = disc.average() if getattr(self.mobility, "uses_pressure", False) else None
 
     def contribute(self, step):
         d = step.d_lag
-        D = self.disc.poiseuille(d, self.mobility.value(d, None), self.mobility.d_dd(d, None))
+        p_film = None if self._average is None else self._average @ step.p
+        D = self.disc.poiseuille(d, self.mobility.value(d, p_film), self.mobility.d_dd(d, p_film))
         return Contribution(matrix=D * step.beta)
 
 

@@ -188,7 +188,10 @@ def describe(obj, depth: int = 0):
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         out = {"type": type(obj).__name__}
         for f in dataclasses.fields(obj):
-            out[f.name] = describe(getattr(obj, f.name), depth + 1)
+            value = getattr(obj, f.name)
+            if f.metadata.get("describe") == "omit_default" and value == f.default:
+                continue  # an option added later: scenes without it describe as before
+            out[f.name] = describe(value, depth + 1)
         return out
     if isinstance(obj, (bool, str)) or obj is None:
         return obj

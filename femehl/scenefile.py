@@ -35,10 +35,10 @@ relative to the scene file; so is a [run] mesh that is not a ladder name
 only in Python.
 
 Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
-load]) states the paper's experiment in SI units and replaces the tables
-above, except ``[indenter]``, which may then give an analytic shape in metres
-(R of [si] is the normalizing radius of curvature; ``load`` [N] imposes a
-constant load instead of the gap ramp).  ``femehl run`` then also writes
+load, alpha (Barus, 1/Pa) or roelands_Z (Roelands, with eta as eta0)]) states the
+paper's experiment in SI units and replaces the tables above, except ``[indenter]``,
+which may then give an analytic shape in metres (R of [si] is the normalizing radius
+of curvature; ``load`` [N] imposes a constant load instead of the gap ramp).  ``femehl run`` then also writes
 ``summary_si.csv``.  See ``examples/sphere_si.toml``.
 Every problem raises :class:`~femehl.errors.SceneFileError` naming the file
 and the key to fix.
@@ -267,8 +267,8 @@ def _si_scene(raw, path):
     if not isinstance(si, dict):
         raise SceneFileError(f"{path}: [si] must be a table.")
     si = dict(si)
-    keys = {"R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L", "load"}
-    optional = {"nu", "t1", "T", "L", "load"}
+    keys = {"R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L", "load", "alpha", "roelands_Z"}
+    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z"}
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
     if extra or missing:
@@ -292,6 +292,19 @@ def _si_scene(raw, path):
             changes["motion"] = Motion(
                 gap=Constant(scene.motion.hc(0.0)), velocity=scene.motion.velocity, load=Constant(F)
             )
+        if "alpha" in si or "roelands_Z" in si:  # pressure-viscosity: Barus [1/Pa], or Roelands
+            from .viscosity import Barus, Roelands
+
+            if "roelands_Z" in si:
+                if "alpha" in si:
+                    raise SceneFileError(
+                        f"{path}: [si] gives alpha (Barus) and roelands_Z (Roelands): give one; "
+                        "Roelands takes its slope from eta and Z."
+                    )
+                model = Roelands.from_si(si["eta"], dim, Z=si["roelands_Z"])
+            else:
+                model = Barus.from_si(si["alpha"], dim)
+            changes["fluid"] = dataclasses.replace(scene.fluid, viscosity=model)
         if changes:
             scene = dataclasses.replace(scene, **changes)
     except SceneFileError:

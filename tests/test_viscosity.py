@@ -195,3 +195,21 @@ def test_toml(tmp_path):
     f.write_text(line + '\n[fluid.viscosity]\nkind = "barus"\nalpha = 1.5\n')
     sc, _ = load_scene_file(f)
     assert sc.viscosity == femehl.Barus(1.5)
+
+
+def test_si_scene_file(tmp_path):
+    """[si] alpha (1/Pa) is Barus.from_si; roelands_Z is Roelands.from_si with eta as eta0."""
+    from femehl.scenefile import load_scene_file
+
+    src = (pathlib.Path(__file__).parents[1] / "examples" / "sphere_si.toml").read_text()
+    f = tmp_path / "s.toml"
+    f.write_text(src.replace("[si]\n", "[si]\nalpha = 2e-8\n"))
+    sc, run = load_scene_file(f)
+    dim = run["_dimensional"]
+    assert sc.viscosity == femehl.Barus.from_si(2e-8, dim)
+    f.write_text(src.replace("[si]\n", "[si]\nroelands_Z = 0.6\n"))
+    sc, run = load_scene_file(f)
+    assert sc.viscosity == femehl.Roelands.from_si(run["_dimensional"].eta, run["_dimensional"], Z=0.6)
+    f.write_text(src.replace("[si]\n", "[si]\nalpha = 2e-8\nroelands_Z = 0.6\n"))
+    with pytest.raises(SceneError, match="give one"):
+        load_scene_file(f)

@@ -118,7 +118,7 @@ class RelaxationStepper:
             raise SceneError(f"tol must be in (0, 1), got {tol!r}.")
         if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
             raise SceneError(f"max_iter must be an integer >= 1, got {max_iter!r}.")
-        if scene.motion.load_controlled:
+        if scene.motion.solves_hc:
             raise SceneError("the relaxation baseline handles imposed-gap scenes only.")
         self.fe = make_stepper(scene, "fe", mesh=mesh, **fe_options)
         self.scene = scene

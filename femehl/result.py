@@ -21,7 +21,7 @@ __all__ = ["Result"]
 
 _SCALARS = ("t", "hc", "V", "load", "film_center", "film_min", "p_max")
 #: per-step records of the time stepping (``state.info``): step size and local error estimate
-_STEPPING = ("dt", "error_estimate")
+_STEPPING = ("dt", "error_estimate", "hc_dot")
 
 
 @dataclass
@@ -59,6 +59,8 @@ class Result:
         info = state.info or {}
         self._rows["dt"].append(float(info.get("dt", 0.0)))
         self._rows["error_estimate"].append(float(info.get("error_estimate", np.nan)))
+        hc_dot = getattr(state, "hc_dot", None)  # a free indenter's velocity (NaN: hc imposed)
+        self._rows["hc_dot"].append(np.nan if hc_dot is None else float(hc_dot))
         if store_fields:
             self._stored.append(state)
 
@@ -180,6 +182,33 @@ class Result:
         pa = np.asarray(self._rows["p_max_at"], dtype=float).reshape(-1, 2)
         out.update(film_min_x=at[:, 0], film_min_y=at[:, 1], p_max_x=pa[:, 0], p_max_y=pa[:, 1])
         return out
+
+    def impact(self) -> dict:
+        """A free indenter's collision: approach and rebound speed, restitution, thinnest film.
+
+        ``v_in``: the fastest approach (most negative dhc/dt) before the deepest point
+        ``hc_min`` (at ``t_hc_min``); ``v_out``: the fastest rebound after it (0 if the
+        indenter never moves back up); ``restitution = v_out / |v_in|``; ``film_min`` and
+        ``t_film_min``: the thinnest film of the run (the true minimum, nodes included).
+        """
+        v = self.hc_dot
+        if not np.any(np.isfinite(v)):
+            raise SceneError("impact() describes a free indenter: give the motion a mass (Motion(mass=...)).")
+        hc, t = self.hc, self.t
+        k = int(np.argmin(hc))
+        v_in = float(np.nanmin(v[: k + 1]))
+        v_out = max(0.0, float(np.nanmax(v[k:])))
+        j = int(np.argmin(self.film_min))
+        return {
+            "v_in": v_in,
+            "v_out": v_out,
+            "restitution": v_out / abs(v_in) if v_in < 0 else float("nan"),
+            "hc_min": float(hc[k]),
+            "t_hc_min": float(t[k]),
+            "film_min": float(self.film_min[j]),
+            "t_film_min": float(t[j]),
+            "rebounded": bool(v_out > 0.0),
+        }
 
     def value_at(self, name: str, t: float) -> float:
         """A per-step scalar (e.g. "load") at time ``t``, linear in time between steps."""

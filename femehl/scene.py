@@ -263,17 +263,67 @@ class Motion:
         load at t = 0 or any sampled time is refused).  Then hc(t) is solved for at every step
         (one more unknown, one more row: the step stays one linear system) and
         ``gap`` only gives the initial clearance hc(0).
+    mass : float, optional
+        A *free* indenter of this (normalized) mass: hc(t) follows Newton's law
+        ``mass hc'' = int p dA - force(t)`` (the film pushes it up, ``force`` down), as one
+        more unknown and row of the same linear system.  ``gap`` gives hc(0).
+    force : callable or float, default: 0 with ``mass``
+        The applied force pressing the free indenter toward the substrate (gravity, a
+        spring, a history); any sign.
+    hc_dot0 : float, default: 0.0
+        Initial velocity of the free indenter (negative: approaching, a drop).
     """
 
     gap: Callable[[float], float] = field(default_factory=RampHold)
     velocity: Callable[[float], float] = field(default_factory=Constant)
     load: Callable[[float], float] | None = None
+    mass: float | None = field(default=None, metadata={"describe": "omit_default"})
+    force: Callable[[float], float] | None = field(default=None, metadata={"describe": "omit_default"})
+    hc_dot0: float = field(default=0.0, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
         object.__setattr__(self, "gap", _as_time_function("Motion gap hc(t)", self.gap))
         object.__setattr__(self, "velocity", _as_time_function("Motion velocity V(t)", self.velocity))
         if self.load is not None:
             object.__setattr__(self, "load", _as_time_function("Motion load F(t)", self.load))
+        if self.mass is None:
+            if self.force is not None or self.hc_dot0 != 0.0:
+                raise SceneError(
+                    "force and hc_dot0 belong to a free indenter: give mass=... too (or load=... "
+                    "for an indenter whose load the film carries at every instant)."
+                )
+            return
+        if self.load is not None:
+            raise SceneError(
+                "give either load (the film carries it at every instant) or mass and force (a free "
+                "indenter with inertia), not both."
+            )
+        object.__setattr__(
+            self, "mass", check_positive("mass", self.mass, "The free indenter's normalized mass (> 0).")
+        )
+        object.__setattr__(self, "hc_dot0", check_finite("hc_dot0", self.hc_dot0, "An initial velocity."))
+        force = 0.0 if self.force is None else self.force
+        object.__setattr__(self, "force", _as_time_function("Motion force(t)", force))
+
+    @property
+    def free(self) -> bool:
+        """True for a free indenter (hc(t) from Newton's law with ``mass`` and ``force``)."""
+        return self.mass is not None
+
+    @property
+    def solves_hc(self) -> bool:
+        """hc(t) is an unknown of each step: an imposed load or a free indenter."""
+        return self.load is not None or self.mass is not None
+
+    def applied_force(self, t: float) -> float:
+        """The free indenter's applied force at ``t`` (finite)."""
+        return call_time_function(
+            "the force history force(t)",
+            "force",
+            self.force,
+            t,
+            "The force history must return finite values.",
+        )
 
     @property
     def load_controlled(self) -> bool:
@@ -286,7 +336,10 @@ class Motion:
         velocity and of the gap (or, under imposed load, of the load: the gap then only
         gives hc(0)).  A callable without a ``breakpoints`` attribute contributes none.
         Adaptive time stepping (:mod:`femehl.core.adaptive`) lands on these times."""
-        funcs = [self.velocity, self.load if self.load_controlled else self.gap]
+        funcs = [
+            self.velocity,
+            self.load if self.load_controlled else (self.force if self.free else self.gap),
+        ]
         times = set()
         for f in funcs:
             for t in getattr(f, "breakpoints", ()) or ():
@@ -349,7 +402,7 @@ class SceneEffects:
         return any(self.motion.V(t) != 0.0 for t in ts)
 
     def has_squeeze(self, t_end: float, n: int = 2001) -> bool:
-        if self.motion.load_controlled:
+        if self.motion.solves_hc:
             return True
         ts = np.linspace(0.0, t_end, n)
         h = [self.motion.hc(t) for t in ts]
@@ -362,6 +415,7 @@ class SceneEffects:
             "sliding": self.has_sliding(t_end),
             "elasticity": self.substrate.kind,
             "imposed_load": self.motion.load_controlled,
+            **({"free_indenter": True} if self.motion.free else {}),
         }
 
 

@@ -18,6 +18,8 @@ A commented example is ``examples/paper_sphere.toml``; the format::
     [motion.load]         optional imposed load F(t): a number or a time-function
                           table as above; hc(t) is then solved for and
                           [motion.gap] gives only hc(0)
+    [motion] mass = m     optional: a free indenter, m hc'' = int p dA - force(t), with
+                          force (a number or [motion.force] table) and hc_dot0
     [domain]              L = 2.0
     [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions,
                           tol, operator ("auto" | "dense" | "fast"), operator_tol
@@ -346,15 +348,25 @@ def _motion(raw, path) -> Motion:
     if not isinstance(motion, dict):
         raise SceneFileError(f"{path}: [motion] must be a table.")
     motion = dict(motion)
-    extra = set(motion) - {"gap", "velocity", "load"}
+    extra = set(motion) - {"gap", "velocity", "load", "mass", "force", "hc_dot0"}
     if extra:
-        raise SceneFileError(f"{path}: [motion] takes gap, velocity and load, not {sorted(extra)}.")
+        raise SceneFileError(
+            f"{path}: [motion] takes gap, velocity, load, and for a free indenter mass, force and "
+            f"hc_dot0, not {sorted(extra)}."
+        )
     gap = _time_function(motion.get("gap", {"kind": "ramp_hold"}), "motion.gap", path)
     vel = _time_function(motion.get("velocity", 0.0), "motion.velocity", path)
     load = None
     if "load" in motion:
         load = _time_function(motion["load"], "motion.load", path)
-    return Motion(gap=gap, velocity=vel, load=load)
+    free = {}
+    if "force" in motion:
+        free["force"] = _time_function(motion["force"], "motion.force", path)
+    free.update({k: motion[k] for k in ("mass", "hc_dot0") if k in motion})
+    try:
+        return Motion(gap=gap, velocity=vel, load=load, **free)
+    except SceneError as exc:
+        raise SceneFileError(f"{path}: [motion]: {exc}") from None
 
 
 def _is_line(raw) -> bool:

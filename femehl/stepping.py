@@ -57,6 +57,9 @@ class State:
     info: dict = field(default_factory=dict)
     d_prev: np.ndarray | None = None  # d one step earlier (two-step schemes)
     dt_prev: float | None = None  # the step that led to this state
+    hc_dot: float | None = None  # a free indenter's velocity dhc/dt (None: hc is imposed)
+    hc_prev: float | None = None  # a free indenter's hc and velocity one step earlier
+    hc_dot_prev: float | None = None
 
 
 class Stepper(Protocol):

@@ -25,6 +25,7 @@ the film points' own minimum), and a film <= 0 anywhere raises
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -168,7 +169,7 @@ class LaggedStepper:
         return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
 
     # ---- states -------------------------------------------------------------------------
-    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None) -> State:
+    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, hc_dot=None) -> State:
         disc = self.disc
         if Cp is None:
             Cp = np.asarray(self.C @ p).ravel()
@@ -207,6 +208,7 @@ class LaggedStepper:
             info=info,
             d_prev=d_prev,
             dt_prev=dt_prev,
+            hc_dot=hc_dot,
         )
 
     def _probe(self, hc, p, Cp, d_min):
@@ -249,7 +251,8 @@ class LaggedStepper:
 
     def initial_state(self) -> State:
         mo = self.scene.motion
-        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n))
+        hc_dot = mo.hc_dot0 if mo.free else None
+        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), hc_dot=hc_dot)
 
     # ---- one step -----------------------------------------------------------------------
     def step(self, state: State, t_new: float, dt: float) -> State:
@@ -270,17 +273,21 @@ class LaggedStepper:
         )
         op, rhs = self.operator(ctx)
         G = op.G
-        if mo.load_controlled:
-            F = mo.F(t_new)
+        hc_dot = None
+        if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
             ones = np.ones(self.shape.size)
             (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ self.shape, G @ ones], t_new)
-            den = float(self.g @ x2)
-            if not np.isfinite(den) or den == 0.0:
-                raise SingularSystemError(
-                    f"step at t = {t_new:.6g}: the load row is singular (the film does not respond to hc).",
-                    t=t_new,
-                )
-            hc = (float(self.g @ x1) - F) / den
+            g1, g2 = float(self.g @ x1), float(self.g @ x2)
+            if mo.free:
+                hc, hc_dot = self._newton_row(state, t_new, dt, g1, g2, a0, a1, a2)
+            else:  # the load row: g . p = F
+                if not np.isfinite(g2) or g2 == 0.0:
+                    raise SingularSystemError(
+                        f"step at t = {t_new:.6g}: the load row is singular (the film does not "
+                        "respond to hc).",
+                        t=t_new,
+                    )
+                hc = (g1 - mo.F(t_new)) / g2
             p = x1 - hc * x2
             Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
         else:
@@ -296,4 +303,35 @@ class LaggedStepper:
         info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
         if self.solver.residuals:
             info["residual"] = max(self.solver.residuals)
-        return self._state(state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info)
+        new = self._state(
+            state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info, hc_dot=hc_dot
+        )
+        if hc_dot is None:
+            return new
+        return dataclasses.replace(new, hc_prev=state.hc, hc_dot_prev=state.hc_dot)
+
+    def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):
+        """hc and dhc/dt of a free indenter: ``m hc'' = load - force`` by the step's own
+        scheme (BDF2 with its variable-step coefficients, or Euler) on hc and v = hc':
+
+            a0 hc' - (a1 hc - a2 hc_prev) = dt v',   m (a0 v' - (a1 v - a2 v_prev)) = dt f',
+
+        ``f' = g . p' - force(t')`` with ``g . p' = g1 - hc' g2`` linear in hc': one more
+        row, solved in closed form.  L-stable: a small mass tends to the imposed-load step
+        (``hc' = (g1 - force)/g2`` at m = 0)."""
+        mo = self.scene.motion
+        m = mo.mass
+        v = state.hc_dot if state.hc_dot is not None else mo.hc_dot0
+        if a2 != 0.0 and state.hc_prev is not None and state.hc_dot_prev is not None:
+            h_hist, v_hist = a1 * state.hc - a2 * state.hc_prev, a1 * v - a2 * state.hc_dot_prev
+        else:  # the first step (or after a restart without history): the one-step scheme
+            a0, h_hist, v_hist = 1.0, state.hc, v
+        F_new = mo.applied_force(t_new)
+        den = m * a0 * a0 / dt + dt * g2
+        if not np.isfinite(den) or den == 0.0:
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g}: the free indenter's row is singular (m a0^2/dt + dt g.x2 = 0).",
+                t=t_new,
+            )
+        hc = (dt * (g1 - F_new) + (m / dt) * (a0 * h_hist + dt * v_hist)) / den
+        return hc, (a0 * hc - h_hist) / dt

@@ -89,6 +89,9 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["has_prev"] = np.asarray(state.d_prev is not None)
     arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
+    for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
+        v = getattr(state, k)
+        arrays[k] = np.asarray(np.nan if v is None else v, dtype=float)
     arrays["format"] = np.asarray(FORMAT)
     path = folder / CHECKPOINT
     _atomic_write(path, lambda fh: np.savez(fh, **arrays))
@@ -104,6 +107,14 @@ def _scalar(a: dict, key: str, path, kind=float):
     if v.size != 1:
         raise _bad(path, f"its entry {key!r} is not a single value (shape {v.shape})")
     return kind(v.reshape(()).item())
+
+
+def _optional(a: dict, key: str, path):
+    """A scalar entry that older checkpoints do not have (None if absent or NaN)."""
+    if key not in a:
+        return None
+    v = _scalar(a, key, path)
+    return None if math.isnan(v) else v
 
 
 def load_checkpoint(folder, reference: State | None = None) -> State:
@@ -158,6 +169,10 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         info={"resumed": True},
         d_prev=arrays["d_prev"] if has_prev else None,
         dt_prev=None if math.isnan(dt_prev) else dt_prev,
+        # absent from checkpoints written before free indenters
+        hc_dot=_optional(a, "hc_dot", path),
+        hc_prev=_optional(a, "hc_prev", path),
+        hc_dot_prev=_optional(a, "hc_dot_prev", path),
     )
     if reference is not None:
         check_state(state, reference, path)

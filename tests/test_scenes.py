@@ -512,7 +512,8 @@ def test_scene_file_new_indenters_and_load(tmp_path):
             r"\[motion.load\].*finite \(no NaN",
         ),
         ("[motion]\nload = nan\n", r"\[motion.load\].*finite"),
-        ("[motion]\nforce = 1.0\n", r"\[motion\] takes gap, velocity and load"),
+        ("[motion]\nspeed = 1.0\n", r"\[motion\] takes gap, velocity, load"),
+        ("[motion]\nforce = 1.0\n", r"force and hc_dot0 belong to a free indenter: give mass"),
         (
             "[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n"
             '[indenter]\nkind = "heightmap"\n',

@@ -107,6 +107,8 @@ class LineScene(SceneEffects):
         instead.  ``motion.load`` is accepted too (and moved here); give one of them.
     viscosity : femehl.Barus or femehl.Roelands, optional
         Pressure-dependent viscosity (:mod:`femehl.viscosity`); None: isoviscous.
+    cavitation : {None, "reynolds"}, optional
+        Cavitation condition (:mod:`femehl.cavitation`); None: full Sommerfeld.
     """
 
     default_method = "line"
@@ -117,11 +119,14 @@ class LineScene(SceneEffects):
     L: float = 2.0
     load: Callable[[float], float] | None = None
     viscosity: object = field(default=None, metadata={"describe": "omit_default"})
+    cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from .cavitation import check_cavitation
         from .viscosity import check_viscosity
 
         check_viscosity(self.viscosity)
+        check_cavitation(self.cavitation)
         object.__setattr__(
             self,
             "k",

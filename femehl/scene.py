@@ -227,14 +227,19 @@ class Fluid:
 
     ``viscosity``: None (isoviscous, the paper's) or a pressure-viscosity model,
     :class:`femehl.Barus` or :class:`femehl.Roelands` (:mod:`femehl.viscosity`), lagged one
-    step in the Poiseuille flux.
+    step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's) or
+    ``"reynolds"`` (``p >= 0``, :mod:`femehl.cavitation`).
     """
 
     beta: float = 200.0
     viscosity: object = field(default=None, metadata={"describe": "omit_default"})
+    cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from .cavitation import check_cavitation
         from .viscosity import check_viscosity
+
+        check_cavitation(self.cavitation)
 
         object.__setattr__(
             self,
@@ -433,6 +438,11 @@ class Scene(SceneEffects):
     def viscosity(self):
         """The fluid's pressure-viscosity model (None: isoviscous)."""
         return self.fluid.viscosity
+
+    @property
+    def cavitation(self):
+        """The fluid's cavitation condition (None: full Sommerfeld)."""
+        return self.fluid.cavitation
 
     def __post_init__(self):
         for name, cls in (("fluid", Fluid), ("motion", Motion), ("domain", Domain)):

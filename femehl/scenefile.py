@@ -10,6 +10,7 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           | "cylinder" (R = 1 only): line contact, see below
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
     [fluid]               beta = 200.0
+                          cavitation = "reynolds" (optional: p >= 0; default full Sommerfeld)
     [fluid.viscosity]     optional: kind = "barus" (alpha) | "roelands" (alpha, p_r, Z),
                           normalized (see femehl.viscosity); isoviscous without it
     [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)
@@ -334,8 +335,8 @@ def _fluid(raw, path) -> dict:
     from .viscosity import VISCOSITY_MODELS
 
     fluid = raw.get("fluid", {})
-    if not isinstance(fluid, dict) or set(fluid) - {"beta", "viscosity"}:
-        raise SceneFileError(f"{path}: [fluid] takes beta and a [fluid.viscosity] table only.")
+    if not isinstance(fluid, dict) or set(fluid) - {"beta", "viscosity", "cavitation"}:
+        raise SceneFileError(f"{path}: [fluid] takes beta, cavitation and a [fluid.viscosity] table only.")
     fluid = dict(fluid)
     if "viscosity" in fluid:
         fluid["viscosity"] = _build(VISCOSITY_MODELS, fluid["viscosity"], "fluid.viscosity", path)
@@ -414,7 +415,7 @@ def _line_scene(raw, path):
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
     kw = {"k": winkler.k, "motion": motion}
-    kw.update({k: fluid[k] for k in ("beta", "viscosity") if k in fluid})
+    kw.update({k: fluid[k] for k in ("beta", "viscosity", "cavitation") if k in fluid})
     if "L" in domain:
         kw["L"] = domain["L"]
     try:

@@ -60,6 +60,7 @@ class State:
     hc_dot: float | None = None  # a free indenter's velocity dhc/dt (None: hc is imposed)
     hc_prev: float | None = None  # a free indenter's hc and velocity one step earlier
     hc_dot_prev: float | None = None
+    p_aux: np.ndarray | None = None  # cavitation: p off the cavitated set, -multiplier on it
 
 
 class Stepper(Protocol):

@@ -145,6 +145,39 @@ class StepOperator:
         G = self.G if G is None else G
         return self.D @ Z + G @ CZ
 
+    def with_fixed(self, fixed) -> StepOperator:
+        """The operator with the rows ``fixed`` replaced by identity rows (``x_i = b_i``).
+
+        ``A' = R A + E`` with ``R`` the identity without the fixed rows and ``E`` their
+        unit diagonal: ``D' = R D + E``, ``F' = R F`` and ``(F C)' = R (F C)`` (a dense
+        product is masked row by row when it is read, never copied).  Used for pressures
+        held at 0 (cavitated nodes).
+        """
+        fixed = np.asarray(fixed, dtype=np.int64)
+        if fixed.size == 0:
+            return self
+        n = self.D.shape[0]
+        keep = np.ones(n)
+        keep[fixed] = 0.0
+        R = sp.diags(keep)
+        E = sp.csr_matrix((np.ones(fixed.size), (fixed, fixed)), shape=(n, n))
+        films = [
+            (c, (R @ F).tocsr(), (R @ FC).tocsr() if sp.issparse(FC) else _RowMasked(FC, keep))
+            for c, F, FC in self.films
+        ]
+        return StepOperator(D=(R @ self.D + E).tocsr(), films=films, C=self.C, key=self.key)
+
+
+class _RowMasked:
+    """A dense ``F C`` read with some rows zeroed (``matrix()`` reads row blocks)."""
+
+    def __init__(self, FC, keep):
+        self.FC, self.keep = FC, keep
+        self.shape = FC.shape
+
+    def __getitem__(self, rows):
+        return self.FC[rows] * self.keep[rows, None]
+
 
 #: name -> linear solver class
 LINEAR_SOLVERS: dict[str, type] = {}

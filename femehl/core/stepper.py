@@ -108,6 +108,10 @@ class LaggedStepper:
         self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
         self.shape = disc.shape
         self.g = disc.load_weights
+        from ..cavitation import CAVITATION_MODELS
+
+        cav = getattr(scene, "cavitation", None)
+        self.cavitation = None if cav is None else CAVITATION_MODELS[cav]()
         self._FC: dict[str, object] = {}
         self._rows_cache: dict[int, np.ndarray] = {}
         self.info = dict(disc.info)
@@ -272,6 +276,12 @@ class LaggedStepper:
             t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
         )
         op, rhs = self.operator(ctx)
+        full, rhs_full = op, rhs
+        fixed = self.cavitation.fixed(state) if self.cavitation is not None else np.zeros(0, dtype=np.int64)
+        if fixed.size:  # cavitated nodes: p = 0 rows, the set from the previous step
+            op = op.with_fixed(fixed)
+            rhs = rhs.copy()
+            rhs[fixed] = 0.0
         G = op.G
         hc_dot = None
         if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
@@ -306,9 +316,25 @@ class LaggedStepper:
         new = self._state(
             state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info, hc_dot=hc_dot
         )
-        if hc_dot is None:
-            return new
-        return dataclasses.replace(new, hc_prev=state.hc, hc_dot_prev=state.hc_dot)
+        extra = {}
+        if hc_dot is not None:
+            extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
+        if self.cavitation is not None:
+            extra["p_aux"] = self._complementarity(full, rhs_full, p, new.d, fixed, new.info)
+        return dataclasses.replace(new, **extra) if extra else new
+
+    def _complementarity(self, op, rhs, p, d, fixed, info):
+        """``y = p`` off the cavitated set, ``-(A p - b)`` on it (the multiplier, unmasked
+        system): the next step's set is ``{y < 0}``; area and extremes go to ``info``."""
+        y = np.array(p, dtype=float)
+        if fixed.size:
+            r = op.D @ p + op.G @ d - rhs
+            y[fixed] = -r[fixed]
+        info["cavitated_area"] = float(self.g[y < 0.0].sum())
+        free = np.ones(p.size, dtype=bool)
+        free[fixed] = False
+        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
+        return y
 
     def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):
         """hc and dhc/dt of a free indenter: ``m hc'' = load - force`` by the step's own

@@ -119,6 +119,11 @@ class FDDisc:
                 f"it needs an indenter symmetric in y; {type(scene.indenter).__name__} is not. "
                 "Use method='fe' (it meshes the full disk for such shapes)."
             )
+        if getattr(scene, "cavitation", None) is not None:
+            raise SceneError(
+                "the FD reference is the paper's full-Sommerfeld scheme: use method='fe' for a "
+                "cavitation condition."
+            )
         if getattr(scene, "viscosity", None) is not None:
             raise SceneError(
                 "the FD reference keeps the paper's isoviscous non-conservative form (its Eq. 13b "

@@ -89,6 +89,7 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["has_prev"] = np.asarray(state.d_prev is not None)
     arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
+    arrays["p_aux"] = np.zeros(0) if state.p_aux is None else np.asarray(state.p_aux, dtype=float)
     for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
         v = getattr(state, k)
         arrays[k] = np.asarray(np.nan if v is None else v, dtype=float)
@@ -173,6 +174,7 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         hc_dot=_optional(a, "hc_dot", path),
         hc_prev=_optional(a, "hc_prev", path),
         hc_dot_prev=_optional(a, "hc_dot_prev", path),
+        p_aux=np.asarray(a["p_aux"], dtype=float) if "p_aux" in a and a["p_aux"].size else None,
     )
     if reference is not None:
         check_state(state, reference, path)

@@ -126,3 +126,38 @@ def test_bad_cavitation_and_fd_and_toml(tmp_path):
     f = tmp_path / "s.toml"
     f.write_text(src.replace("[fluid]\n", '[fluid]\ncavitation = "reynolds"\n'))
     assert load_scene_file(f)[0].cavitation == "reynolds"
+
+
+def test_series_and_maps_show_the_cavitated_region(tmp_path):
+    """The VTK series carries ``cavitated`` (1 where p is held at 0, mirrored with the half
+    disk), and the maps hatch that region instead of drawing a p = 0 contour."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import meshio
+
+    from femehl.output import plots
+    from femehl.output.snapshot import read_snapshot
+
+    sc = femehl.presets.paper_sphere()
+    cav = dataclasses.replace(sc, fluid=Fluid(sc.fluid.beta, cavitation="reynolds"))
+    res = femehl.solve(cav, t_end=2.5, dt=0.05, mesh="coarse", scheme="bdf2", estimate=False, store_every=10)
+    res.save(tmp_path)
+    m = meshio.read(sorted(tmp_path.glob("fields_*.vtu"))[-1])
+    flag = m.point_data["cavitated"]
+    assert set(np.unique(flag)) == {0.0, 1.0}
+    # held at 0 (to the Krylov tolerance), or joining the set after its one negative step
+    p = m.point_data["pressure"]
+    assert np.max(np.abs(p[flag == 1.0])) <= 3e-3 * p.max()
+    assert np.all(p[flag == 0.0] >= -1e-12 * p.max())
+    y = m.points[:, 1]
+    assert flag[y > 1e-9].sum() == flag[y < -1e-9].sum()  # the image carries the same set
+    snap = read_snapshot(tmp_path)
+    fig = plots.maps_figure(snap)
+    p_ax = fig.get_axes()[1]
+    labels = [h.get_label() for h in p_ax.get_legend_handles_labels()[0]]
+    assert "cavitated (p = 0)" in labels and "p = 0" not in labels
+    matplotlib.pyplot.close(fig)
+    full = femehl.solve(sc, t_end=0.2, dt=0.1, mesh="coarse", estimate=False)
+    full.save(tmp_path / "full")
+    assert "cavitated" not in meshio.read(sorted((tmp_path / "full").glob("fields_*.vtu"))[-1]).point_data

@@ -8,7 +8,8 @@
 * :func:`maps_figure` (``maps.png``): film on a logarithmic colour scale and pressure on a
   scale centred at p = 0 (sub-ambient blue) with the p = 0 contour, over a window of
   :data:`WINDOW` contact radii (the contact: where p > 5 % of its peak), the minimum film
-  marked; a half-disk run is shown mirrored (the whole contact);
+  marked, the cavitated region hatched (a run with a cavitation condition); a half-disk
+  run is shown mirrored (the whole contact);
 * :func:`centreline_png` (``centreline.png``): p and d along y = 0 at several times;
 * :func:`animation_file`: the maps and the centreline, one frame per stored time (GIF
   through matplotlib's Pillow writer), on request only (0.16 s a frame on the coarse
@@ -303,13 +304,19 @@ def maps_figure(snap, title: str = ""):
     im = ax_p.tripcolor(tri, p, shading="gouraud", cmap="RdBu_r", norm=pnorm)
     fig.colorbar(im, ax=ax_p, shrink=0.85, label="pressure p (blue: below ambient)")
     a = contact_radius(snap)
-    if lo < 0.0 < float(np.nanmax(p)) and a is not None:
+    if lo < 0.0 < float(np.nanmax(p)) and a is not None and snap.cavitated is None:
         # p = 0 where it bounds the loaded region (within 1.25 contact radii: farther out p is ~0
-        # everywhere and its sign is noise)
+        # everywhere and its sign is noise); with cavitation p >= 0 and the hatch shows p = 0
         near = mtri.Triangulation(snap.points[:, 0], snap.points[:, 1], snap.triangles)
         near.set_mask(np.hypot(cen[:, 0], cen[:, 1]) > 1.25 * a)
         ax_p.tricontour(near, p, levels=[0.0], colors="k", linewidths=0.8)
         ax_p.plot([], [], color="k", lw=0.8, label="p = 0")
+    if snap.cavitated is not None and np.any(snap.cavitated > 0.5):
+        # a cavitation condition: hatch where the pressure is held at 0
+        ax_p.tricontourf(tri, snap.cavitated, levels=[0.5, 1.5], colors="none", hatches=["////"])
+        import matplotlib.patches as mpatches
+
+        ax_p.add_patch(mpatches.Rectangle((0, 0), 0, 0, fill=False, hatch="////", label="cavitated (p = 0)"))
     x0, y0 = snap.film_min_at
     xs, ys = ([x0, x0], [y0, -y0]) if snap.mirrored and abs(y0) > 0 else ([x0], [y0])
     for ax in (ax_d, ax_p):

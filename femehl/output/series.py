@@ -2,7 +2,8 @@
 
 Written as the run goes: every stored state adds its .vtu and rewrites the
 small .pvd index (atomically), so an interrupted run leaves a readable
-series.  Pressure is point data; film thickness ``d``, deflection ``w`` and
+series.  Pressure is point data (with ``cavitated``, 1 where the pressure is held at 0,
+for a run with a cavitation condition); film thickness ``d``, deflection ``w`` and
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
 normalized; z = 0.  A half-disk run (computed on y >= 0) is written as the
@@ -85,6 +86,9 @@ class SeriesWriter:
         else:
             point_data = {"pressure": p}
             cell_data = {"film": [d], "deflection": [w], "gap": [h]}
+        cav = cavitated_nodes(self.disc, state)
+        if cav is not None:  # a run with a cavitation condition: 1 where p is held at 0
+            point_data["cavitated"] = cav[self._source] if self.mirrored else cav
         mesh = meshio.Mesh(
             self.points,
             self.cells,
@@ -118,6 +122,16 @@ class SeriesWriter:
 
 _GRID_TAG = b"<UnstructuredGrid>"
 _TIME_RE = re.compile(rb'Name="TimeValue"[^>]*>\s*([^<\s]+)\s*<')
+
+
+def cavitated_nodes(disc, state):
+    """1.0 at the cavitated nodes of ``state`` (``y < 0``: held at p = 0 with a multiplier
+    that keeps them there, or negative and joining the set at the next step), 0.0
+    elsewhere; None for a full-Sommerfeld run (no complementarity variable)."""
+    y = getattr(state, "p_aux", None)
+    if y is None:
+        return None
+    return disc.expand((np.asarray(y) < 0.0).astype(float))
 
 
 def _add_field_data(path: pathlib.Path, values: dict) -> None:

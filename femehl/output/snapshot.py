@@ -75,6 +75,7 @@ class Snapshot:
     film_min_at: tuple[float, float]
     mirrored: bool
     L: float
+    cavitated: np.ndarray | None = None  # (n,) 1 where p is held at 0 (a cavitation condition)
 
     @property
     def film_at_points(self) -> np.ndarray:
@@ -114,7 +115,9 @@ def _degenerate(tris, pts):
     return np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])) <= 0
 
 
-def _build(t, points, cells, pressure, film, on_points, mirrored, L, film_min=None, film_min_at=None):
+def _build(
+    t, points, cells, pressure, film, on_points, mirrored, L, film_min=None, film_min_at=None, cav=None
+):
     tris, owner = _triangles(cells)
     pts = np.asarray(points, dtype=float)[:, :2]
     keep = ~_degenerate(tris, pts)
@@ -136,21 +139,27 @@ def _build(t, points, cells, pressure, film, on_points, mirrored, L, film_min=No
         (float(film_min_at[0]), float(film_min_at[1])),
         bool(mirrored),
         float(L),
+        None if cav is None else np.asarray(cav, dtype=float),
     )
 
 
 def snapshot(disc, state) -> Snapshot:
     """The :class:`Snapshot` of ``state`` (full disk: a half-disk run is mirrored)."""
+    from .series import cavitated_nodes
+
     points, cells, on_points = disc.vtk_geometry()
     p, d = np.asarray(state.p, dtype=float), np.asarray(state.d, dtype=float)
+    cav = cavitated_nodes(disc, state)
     half = bool(getattr(disc, "half", False))
     if half:
         points, full_cells, source = mirror_half(points, cells)
         p = p[source]
         d = d[source] if on_points else np.concatenate([d, d])
+        cav = None if cav is None else cav[source]
         cells = full_cells
     L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
-    return _build(state.t, points, cells, p, d, on_points, half, L, state.film_min, tuple(state.film_min_at))
+    fmin, at = state.film_min, tuple(state.film_min_at)
+    return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav)
 
 
 # ---- reading a run folder ----------------------------------------------------------------
@@ -230,8 +239,9 @@ def read_snapshot(folder, t: float | None = None) -> Snapshot:
         j = int(np.argmin(np.abs(rows["t"] - ts[k])))
         if abs(rows["t"][j] - ts[k]) <= 1e-9 * max(1.0, abs(ts[k])):
             fmin, where = rows["film_min"][j], (rows["film_min_x"][j], rows["film_min_y"][j])
+    cav = mesh.point_data.get("cavitated")
     return _build(
-        ts[k], mesh.points, cells, mesh.point_data["pressure"], film, on_points, mirrored, L, fmin, where
+        ts[k], mesh.points, cells, mesh.point_data["pressure"], film, on_points, mirrored, L, fmin, where, cav
     )
 
 

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import SceneError
+from .validation import check_nonnegative, check_positive
 
 __all__ = ["VISCOSITY_MODELS", "Barus", "PiezoviscousMobility", "Roelands", "register_viscosity"]
 
@@ -49,23 +50,6 @@ def register_viscosity(cls):
     """Class decorator adding a viscosity model to :data:`VISCOSITY_MODELS` under ``cls.kind``."""
     VISCOSITY_MODELS[cls.kind] = cls
     return cls
-
-
-def _nonnegative(name, value, hint):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        v = float("nan")
-    if isinstance(value, bool) or not math.isfinite(v) or v < 0.0:
-        raise SceneError(f"{name} must be a finite number >= 0, got {value!r}. {hint}")
-    return v
-
-
-def _positive(name, value, hint):
-    v = _nonnegative(name, value, hint)
-    if v <= 0.0:
-        raise SceneError(f"{name} must be > 0, got {value!r}. {hint}")
-    return v
 
 
 def _pressure_scale(dim) -> float:
@@ -89,12 +73,12 @@ class Barus:
 
     def __post_init__(self):
         hint = "alpha = alpha_SI [1/Pa] x the pressure scale; Barus.from_si(alpha_SI, dim) converts it."
-        object.__setattr__(self, "alpha", _nonnegative("Barus alpha", self.alpha, hint))
+        object.__setattr__(self, "alpha", check_nonnegative("Barus alpha", self.alpha, hint))
 
     @classmethod
     def from_si(cls, alpha_si: float, dim) -> Barus:
         """From the SI coefficient ``alpha_si`` [1/Pa] and the experiment's Dimensional."""
-        a = _nonnegative("alpha_si", alpha_si, "in 1/Pa, e.g. 2e-8 for a mineral oil.")
+        a = check_nonnegative("alpha_si", alpha_si, "in 1/Pa, e.g. 2e-8 for a mineral oil.")
         return cls(alpha=a * _pressure_scale(dim))
 
     def ratio(self, p):
@@ -114,16 +98,16 @@ class Roelands:
 
     def __post_init__(self):
         hint = "Roelands.from_si(eta0, dim, Z=0.6) converts the SI form (p0 = 1.96e8 Pa)."
-        object.__setattr__(self, "alpha", _nonnegative("Roelands alpha", self.alpha, hint))
-        object.__setattr__(self, "p_r", _positive("Roelands p_r", self.p_r, hint))
-        Z = _positive("Roelands Z", self.Z, "Z is about 0.6 for mineral oils (0 < Z <= 1.5).")
+        object.__setattr__(self, "alpha", check_nonnegative("Roelands alpha", self.alpha, hint))
+        object.__setattr__(self, "p_r", check_positive("Roelands p_r", self.p_r, hint))
+        Z = check_positive("Roelands Z", self.Z, "Z is about 0.6 for mineral oils (0 < Z <= 1.5).")
         object.__setattr__(self, "Z", Z)
 
     @classmethod
     def from_si(cls, eta0: float, dim, Z: float = 0.6, p0: float = 1.96e8) -> Roelands:
         """From the ambient viscosity ``eta0`` [Pa s], the Dimensional, ``Z`` and ``p0`` [Pa]."""
-        eta0 = _positive("eta0", eta0, "the ambient viscosity in Pa s.")
-        p0 = _positive("p0", p0, "Roelands' reference pressure, 1.96e8 Pa.")
+        eta0 = check_positive("eta0", eta0, "the ambient viscosity in Pa s.")
+        p0 = check_positive("p0", p0, "Roelands' reference pressure, 1.96e8 Pa.")
         A = math.log(eta0) + 9.67
         if A <= 0.0:
             raise SceneError(

@@ -159,7 +159,7 @@ def test_si_conversions():
 @pytest.mark.parametrize(
     "make,words",
     [
-        (lambda: femehl.Barus(-1.0), "alpha must be a finite number >= 0"),
+        (lambda: femehl.Barus(-1.0), "alpha must be >= 0"),
         (lambda: femehl.Barus(float("nan")), "alpha"),
         (lambda: femehl.Roelands(alpha=1.0, p_r=0.0), "p_r must be > 0"),
         (lambda: femehl.Roelands(alpha=1.0, Z=-1), "Z must be"),

@@ -27,10 +27,11 @@ import argparse
 import json
 import os
 import pathlib
-import platform
 import subprocess
 import sys
 import time
+
+from _machine import machine
 
 HERE = pathlib.Path(__file__).resolve().parent
 RUNS = HERE / "auto_runs.jsonl"
@@ -159,24 +160,6 @@ def true_errors(rec: dict, ref: dict) -> dict:
             entry["share"] = float(np.mean(est[big] >= 0.5 * true[big])) if big.any() else None
         out[q] = entry
     return out
-
-
-def machine() -> str:
-    model = "?"
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    import numpy
-    import scipy
-
-    return (
-        f"{os.cpu_count()} cores ({model}), python {platform.python_version()}, numpy {numpy.__version__}, "
-        f"scipy {scipy.__version__}, 1 BLAS thread per run"
-    )
 
 
 def _pct(x) -> str:

@@ -21,12 +21,13 @@ import argparse
 import json
 import math
 import os
-import platform
 import resource
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from _machine import machine
 
 HERE = Path(__file__).resolve().parent
 ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", MPLBACKEND="Agg")
@@ -182,25 +183,6 @@ def _run(args: list[str], timeout: float) -> dict | None:
     if p.returncode or not lines:
         return {"args": args, "error": (p.stderr or p.stdout)[-600:]}
     return json.loads(lines[-1])
-
-
-def machine() -> str:
-    import numpy
-    import scipy
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
-    return (
-        f"{os.cpu_count()} cores ({cpu}), {mem:.0f} GiB RAM, python {platform.python_version()}, "
-        f"numpy {numpy.__version__}, scipy {scipy.__version__}, 1 BLAS thread per run"
-    )
 
 
 def fit_exponent(n, y):

@@ -378,7 +378,11 @@ def _bench(args):
             "checkout (git clone), not with an installed wheel."
         )
     sys.argv = [str(script)] + list(args.rest)
-    runpy.run_path(str(script), run_name="__main__")
+    sys.path.insert(0, str(root))  # as `python benchmarks/x.py` would: its helpers import
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    finally:
+        sys.path.remove(str(root))
     return 0
 
 

@@ -453,7 +453,7 @@ def run_case(case: Case, folder) -> dict:
     record = {
         "key": case.key,
         "params": case.params,
-        "options": _jsonable({k: v for k, v in case.options.items()}),
+        "options": _jsonable(case.options),
         "scene": describe(case.scene),
         "femehl": __version__,
         "host": os.uname().nodename if hasattr(os, "uname") else "",

@@ -127,11 +127,10 @@ def result_table(result) -> dict:
     return table
 
 
-def _plateau(t, q, rel):
-    """Earliest time from which ``q`` stays within ``rel`` of its final value (or None)."""
+def _plateau(t, q, tol):
+    """Earliest time from which ``q`` stays within ``tol`` (absolute) of its final value, or None."""
     q = np.asarray(q, dtype=float)
-    scale = max(abs(q[-1]), 1e-300)
-    off = np.flatnonzero(~(np.abs(q - q[-1]) <= rel * scale))
+    off = np.flatnonzero(~(np.abs(q - q[-1]) <= tol))
     if off.size == 0:
         return float(t[0])
     return float(t[off[-1] + 1]) if off[-1] + 1 < t.size else None
@@ -153,12 +152,10 @@ def phases(table: dict) -> list[tuple[str, float, float]]:
     film = np.asarray(table["film_center"], dtype=float)
     sliding = np.abs(V) > 1e-12 * max(1.0, float(np.max(np.abs(V))))
     t_slide = float(t[np.argmax(sliding)]) if sliding.any() else None
-    starts = [_plateau(t, table[q], STEADY_TOL) for q in ("load", "film_center", "film_min")]
-    if sliding.any():
-        starts.append(_plateau(t, V, 1e-9))
+    rel = [(table[q], STEADY_TOL * abs(float(table[q][-1]))) for q in ("load", "film_center", "film_min")]
     # hc on the film's scale: the indenter is still if it moves less than 1 % of the film
-    off = np.flatnonzero(~(np.abs(hc - hc[-1]) <= STEADY_TOL * abs(film[-1])))
-    starts.append(float(t[0]) if off.size == 0 else (float(t[off[-1] + 1]) if off[-1] + 1 < t.size else None))
+    checks = [*rel, (hc, STEADY_TOL * abs(film[-1]))] + ([(V, 1e-9 * abs(V[-1]))] if sliding.any() else [])
+    starts = [_plateau(t, q, tol) for q, tol in checks]
     t_steady = None if any(s is None for s in starts) else max(starts)
     if t_steady is not None and t[-1] - t_steady < STEADY_SPAN * (t[-1] - t[0]):
         t_steady = None  # a few last steps within 1 %: drifting slowly, not steady
@@ -170,7 +167,8 @@ def phases(table: dict) -> list[tuple[str, float, float]]:
         float(np.max(np.abs(load))), 1e-300
     )
     if (t_slide is None or t_slide > t[0]) and moving:
-        out.append(("indentation", float(t[0]), t_slide if t_slide is not None else (t_steady or end)))
+        first = t_slide if t_slide is not None else (t_steady if t_steady is not None else end)
+        out.append(("indentation", float(t[0]), first))
     if t_slide is not None:
         out.append(("start-up", t_slide, t_steady if t_steady is not None else end))
     if t_steady is not None:
@@ -514,9 +512,12 @@ def plot_animation(folder, out=None, fps: int = 8):
 
     if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 60:
         raise OutputError(f"fps must be an integer from 1 to 60, got {fps!r}.")
+    from .table import read_summary
+
     read_snapshot(folder)  # a run folder with a readable series (else OutputError)
     times = [t for t, _ in stored_times(folder)]
-    frames = (lambda k: read_snapshot(folder, times[k]), len(times))
+    table = read_summary(pathlib.Path(folder) / "summary.csv")
+    frames = (lambda k: read_snapshot(folder, times[k], summary=table), len(times))
     return animation_file(
         frames, out or pathlib.Path(folder) / "animation.gif", fps=fps, title=_title_of(folder)
     )

@@ -186,11 +186,12 @@ def check_run_folder(folder) -> pathlib.Path:
     return folder
 
 
-def read_snapshot(folder, t: float | None = None) -> Snapshot:
+def read_snapshot(folder, t: float | None = None, summary: dict | None = None) -> Snapshot:
     """The stored fields of a run folder nearest to time ``t`` (default: the last).
 
     Raises :class:`~femehl.errors.OutputError` if the folder has no field series, or
-    ``t`` is more than half a storage interval from every stored time.
+    ``t`` is more than half a storage interval from every stored time.  ``summary``: the
+    folder's ``summary.csv`` columns if already read (an animation reads them once).
     """
     import meshio
 
@@ -234,7 +235,7 @@ def read_snapshot(folder, t: float | None = None) -> Snapshot:
     L = float(np.max(np.hypot(mesh.points[:, 0], mesh.points[:, 1])))
     fmin = None
     where = None
-    rows = read_summary(folder / "summary.csv")
+    rows = read_summary(folder / "summary.csv") if summary is None else summary
     if rows["t"].size:  # the true minimum film (nodes and origin included) from the table
         j = int(np.argmin(np.abs(rows["t"] - ts[k])))
         if abs(rows["t"][j] - ts[k]) <= 1e-9 * max(1.0, abs(ts[k])):

@@ -327,9 +327,8 @@ class LaggedStepper:
         """``y = p`` off the cavitated set, ``-(A p - b)`` on it (the multiplier, unmasked
         system): the next step's set is ``{y < 0}``; area and extremes go to ``info``."""
         y = np.array(p, dtype=float)
-        if fixed.size:
-            r = op.D @ p + op.G @ d - rhs
-            y[fixed] = -r[fixed]
+        if fixed.size:  # the residual of the held rows only
+            y[fixed] = rhs[fixed] - op.D[fixed] @ p - op.G[fixed] @ d
         info["cavitated_area"] = float(self.g[y < 0.0].sum())
         free = np.ones(p.size, dtype=bool)
         free[fixed] = False

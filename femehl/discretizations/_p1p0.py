@@ -59,6 +59,22 @@ class P1P0:
         """``M[q, e] = int_e q`` (free nodes x elements)."""
         return self._M
 
+    def pressure_gradient(self):
+        """Element gradients of the P1 pressure: one sparse (elements x free nodes) matrix per
+        axis, ``(G[i] p)_e = dp/dx_i`` on element e (constant there), and the element measures."""
+        if getattr(self, "_grad", None) is None:
+            from skfem import BilinearForm
+
+            b0, b1 = self.basis0, self.basis
+            measure = np.asarray(asm(squeeze, b0, b1).sum(axis=0)).ravel()  # int_e 1 (sum of int_e phi_q)
+            inv = sp.diags(1.0 / measure)
+            mats = []
+            for i in range(b1.mesh.p.shape[0]):
+                form = BilinearForm(lambda d, q, w, i=i: d * q.grad[i])
+                mats.append((inv @ asm(form, b0, b1).tocsr()[self.free].T).tocsr())
+            self._grad = (tuple(mats), measure)
+        return self._grad
+
     def average(self):
         """The element average of the P1 pressure (elements x free nodes)."""
         return self.P[:, self.free]

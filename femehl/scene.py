@@ -227,8 +227,9 @@ class Fluid:
 
     ``viscosity``: None (isoviscous, the paper's) or a pressure-viscosity model,
     :class:`femehl.Barus` or :class:`femehl.Roelands` (:mod:`femehl.viscosity`), lagged one
-    step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's) or
-    ``"reynolds"`` (``p >= 0``, :mod:`femehl.cavitation`).
+    step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's),
+    ``"reynolds"`` (``p >= 0``) or ``"half-sommerfeld"`` (the full-Sommerfeld run with its
+    negative pressures clipped in what is reported), see :mod:`femehl.cavitation`.
     """
 
     beta: float = 200.0
@@ -461,6 +462,9 @@ class Scene(SceneEffects):
                 "(the paper case uses h0 = +0.1)."
             )
         self._check_domain_holds_contact()
+        from .cavitation import check_cavitation_scene
+
+        check_cavitation_scene(self)
 
     def _check_domain_holds_contact(self):
         """The domain must reach well past the largest contact of the run, for any indenter.

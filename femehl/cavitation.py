@@ -33,10 +33,11 @@ What each condition gets wrong:
   is created; film and deflection are those of the full-Sommerfeld pressure, not of the
   pressure reported;
 * **Reynolds (Swift-Stieber)**: ``p = 0`` and ``dp/dn = 0`` at rupture, so the flux is
-  continuous where the film ruptures; where the film reforms it is not (no jump
-  condition), and the cavitated region is counted as full of liquid: the multiplier
-  on the held rows is the full-film volume the condition supplies
-  (``info["mass_source"]``, see :class:`ReynoldsCavitation`);
+  continuous where the film ruptures and mass is conserved there; where the film
+  reforms it is not (no jump condition: mass is created or destroyed), and the film
+  content of the cavitated region is not known.  The multiplier on the held rows is the
+  volume the condition supplies to the full-film balance, the cavity's gas intake
+  (``info["full_film_source"]``, see :class:`ReynoldsCavitation`);
 * **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): the mass-conserving model, carrying
   the film content in the cavitated region as an unknown; not in femehl yet.
 
@@ -116,31 +117,38 @@ class ReynoldsCavitation(_Model):
     Each step adds to ``state.info``: ``cavitated_area`` (the area, or in line contact
     the length, of the nodes with ``y < 0``: ``sum_i g_i``, ``g`` the node weights of the
     load), ``p_negative_min`` (the lowest pressure off the held set: the one-step
-    transient of a node joining it) and ``mass_source``.
+    transient of a node joining it) and ``full_film_source``.
 
-    **The mass source.**  Each row ``i`` of the step is the weak form of the film's mass
-    balance ``dd/dt + div J = 0`` (``J = -beta d^3 grad p - V d e_x``, normalized) tested
-    with the hat function ``phi_i``: ``r_i(p) = int phi_i dd/dt - int J . grad phi_i``,
-    in flux units (normalized volume per unit time).  A held row is replaced by
-    ``p_i = 0``, so there the balance is met only with a source: ``r_i(p) = lambda_i``,
-    i.e. ``dd/dt + div J = s`` with ``int phi_i s = lambda_i``.  The volume per unit time
-    the condition supplies is therefore
+    **The full-film source.**  Each row ``i`` of the step is the weak form of the film's
+    mass balance ``dd/dt + div J = 0`` (``J = -beta d^3 grad p - V d e_x``, normalized:
+    the film taken as full of liquid) tested with the hat function ``phi_i``:
+    ``r_i(p) = int phi_i dd/dt - int J . grad phi_i``, in flux units (normalized volume
+    per unit time).  A held row is replaced by ``p_i = 0``, so there the balance is met
+    only with a source: ``r_i(p) = lambda_i``, i.e. ``dd/dt + div J = s`` with
+    ``int phi_i s = lambda_i``.  The volume per unit time the condition supplies is
 
-        mass_source = sum over the held nodes of lambda_i = sum_i (A p - b)_i,
+        full_film_source = sum over the held nodes of lambda_i = sum_i (A p - b)_i
 
-    over the whole plane (twice the half disk's).  Summed with the free rows (whose
-    residual is 0 to the solver's tolerance) it is the global balance ``d/dt int psi d
-    + (outflow - inflow)`` through the rim, ``psi = sum_free phi_i``.  It is the
-    full-film volume: the cavitated region is counted as full, so where the gap diverges
-    behind the contact (rupture) ``mass_source`` is the gas volume the growing gap takes
-    in, not liquid; the liquid imbalance at reformation needs the film content of the
-    cavitated region, which only a mass-conserving (JFO) model carries.  Steady 1-D
-    slider with the cavity open to the outlet: ``mass_source = V (d(-L) - d_c)``, the
-    Couette flux of the gap leaving minus that at rupture.
+    over the whole plane (twice the half disk's sum).  Added to the free rows (residual 0
+    to the solver's tolerance) it is the balance of the fields, ``d/dt int psi d +
+    outflow - inflow`` through the rim (``psi = sum_free phi_i``, 1 but on the rim's
+    elements), the check ``tests/test_cavitation.py`` makes.
+
+    It is *not* the liquid the condition creates.  The cavitated region is counted as
+    full here, but it holds liquid and gas: if the liquid there were conserved (the JFO
+    transport ``d(theta d)/dt + div(-V theta d e_x) = 0``), subtracting it from the
+    full-film balance leaves ``d(v)/dt + div(-V v e_x) = s`` for the gas ``v = (1 -
+    theta) d``: ``full_film_source`` is the rate at which the cavity takes in gas (the
+    diverging gap behind the contact), not a liquid error.  The Reynolds condition's own
+    liquid error is at reformation (where the cavity closes, no jump condition), and
+    measuring it needs the film content ``theta`` of the cavity, which only a
+    mass-conserving model carries.  Steady 1-D slider, the cavity open to the outlet:
+    ``full_film_source = V (d(-L) - d_c)`` (the gap's Couette flux leaving minus that at
+    rupture, ``d_c`` the film there): all of it gas leaving through the outlet.
     """
 
     name = "reynolds"
-    columns = ("cavitated_area", "mass_source")
+    columns = ("cavitated_area", "full_film_source")
     note = (
         "Reynolds (Swift-Stieber): p >= 0, the cavitated set lagged one step; mass is "
         "conserved at rupture, not where the film reforms"
@@ -169,7 +177,7 @@ class ReynoldsCavitation(_Model):
         free = np.ones(p.size, dtype=bool)
         free[fixed] = False
         info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
-        info["mass_source"] = _plane_factor(stepper.disc) * float(lam.sum())
+        info["full_film_source"] = _plane_factor(stepper.disc) * float(lam.sum())
         return dataclasses.replace(new, info=info, p_aux=y)
 
 
@@ -245,7 +253,7 @@ def _plane_factor(disc) -> float:
 
 
 #: every column a cavitation model may add to summary.csv, in a fixed order
-CAVITATION_COLUMNS = ("load_full", "cavitated_area", "mass_source")
+CAVITATION_COLUMNS = ("load_full", "cavitated_area", "full_film_source")
 
 
 def cavitation_model(name):

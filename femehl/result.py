@@ -29,7 +29,7 @@ class Result:
     """Arrays with one entry per step (``t``, ``load``, ``film_center``, ...).
 
     A run with a cavitation condition has its figures too (:attr:`cavitation_columns`:
-    ``cavitated_area``, ``mass_source`` or ``load_full``), as in ``summary.csv``.
+    ``cavitated_area``, ``full_film_source`` or ``load_full``), as in ``summary.csv``.
 
     Attributes
     ----------
@@ -56,7 +56,7 @@ class Result:
     @property
     def cavitation_columns(self) -> tuple:
         """The per-step figures the scene's cavitation condition adds (``()``: full
-        Sommerfeld): ``cavitated_area``, and ``mass_source`` (Reynolds) or ``load_full``
+        Sommerfeld): ``cavitated_area``, and ``full_film_source`` (Reynolds) or ``load_full``
         (half-Sommerfeld), see :mod:`femehl.cavitation`."""
         from .cavitation import cavitation_columns
 

@@ -236,8 +236,8 @@ def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
     assert load_scene_file(toml)[0].cavitation == "half-sommerfeld"
 
 
-def test_mass_source_closes_the_flux_balance():
-    """The Reynolds condition's ``mass_source`` is the flux balance of the fields, computed
+def test_full_film_source_closes_the_flux_balance():
+    """The Reynolds condition's ``full_film_source`` is the flux balance of the fields, computed
     element by element: ``d/dt int psi d + J(L) - J(-L)`` with the element fluxes
     ``J = -beta d*^3 p' - V d`` (``d*`` the lagged film of the step, ``psi`` the sum of the
     free hat functions: half weight on the end elements) -- to round-off, while the set
@@ -257,9 +257,9 @@ def test_mass_source_closes_the_flux_balance():
             s0, s1 = res.states[k - 1], res.states[k]
             J = -BETA * s0.d**3 * np.diff(s1.p) / h - V * s1.d
             balance = np.sum(psi * (s1.d - s0.d)) / (s1.t - s0.t) + J[-1] - J[0]
-            assert s1.info["mass_source"] == pytest.approx(balance, rel=1e-10)
-        assert res.mass_source[-1] == pytest.approx(V * (res.final.d[0] - d_c), rel=2e-3)
-        errs.append(abs(res.mass_source[-1] - V * (_d(-L) - d_c)))
+            assert s1.info["full_film_source"] == pytest.approx(balance, rel=1e-10)
+        assert res.full_film_source[-1] == pytest.approx(V * (res.final.d[0] - d_c), rel=2e-3)
+        errs.append(abs(res.full_film_source[-1] - V * (_d(-L) - d_c)))
     assert errs[1] < 0.3 * errs[0] and errs[1] < 0.01 * V * (_d(-L) - d_c)
 
 
@@ -288,7 +288,7 @@ def test_summary_columns_series_and_restart(tmp_path):
         vtu = sorted((tmp_path / f"{cav}-a").glob("fields_*.vtu"))[-1]
         assert field_value(vtu, "HalfSommerfeldClipped") == (1.0 if cav == "half-sommerfeld" else None)
     assert cols[None] == COLUMNS
-    assert cols["reynolds"] == COLUMNS + ("cavitated_area", "mass_source")
+    assert cols["reynolds"] == COLUMNS + ("cavitated_area", "full_film_source")
     assert cols["half-sommerfeld"] == COLUMNS + ("load_full", "cavitated_area")
     text = sorted((tmp_path / "half-sommerfeld-a").glob("fields_*.vtu"))[-1].read_text(errors="ignore")
     assert "half-Sommerfeld: negative pressures clipped after the solve" in text

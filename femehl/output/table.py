@@ -1,7 +1,7 @@
 """The summary CSV: one row per step, written and flushed as the run goes.
 
 The columns are :data:`COLUMNS`; a run with a cavitation condition adds the condition's
-(:func:`columns_for`: ``cavitated_area`` and, for the Reynolds condition, ``mass_source``,
+(:func:`columns_for`: ``cavitated_area`` and, for the Reynolds condition, ``full_film_source``,
 for half-Sommerfeld ``load_full``; see :mod:`femehl.cavitation`), read from ``state.info``.
 """
 

@@ -53,21 +53,26 @@ class Result:
     #: an expert run with adaptive steps has the time part only (``space``, ``total`` None)
     estimate: dict | None = None
 
+    def __post_init__(self):
+        from .cavitation import cavitation_columns
+
+        self._cavitation_columns = cavitation_columns(self.scene)
+        for k in self._cavitation_columns:
+            self._rows.setdefault(k, [])
+
     @property
     def cavitation_columns(self) -> tuple:
         """The per-step figures the scene's cavitation condition adds (``()``: full
         Sommerfeld): ``cavitated_area``, and ``full_film_source`` (Reynolds) or ``load_full``
         (half-Sommerfeld), see :mod:`femehl.cavitation`."""
-        from .cavitation import cavitation_columns
-
-        return cavitation_columns(self.scene)
+        return self._cavitation_columns
 
     def record(self, state: State, store_fields: bool = True) -> None:
         """Append one state's scalars (and its fields when ``store_fields``)."""
         for k in _SCALARS:
             self._rows[k].append(float(getattr(state, k)))
         for k in self.cavitation_columns:  # NaN where a state does not carry it
-            self._rows.setdefault(k, []).append(float((state.info or {}).get(k, np.nan)))
+            self._rows[k].append(float((state.info or {}).get(k, np.nan)))
         self._rows["film_min_at"].append(tuple(state.film_min_at))
         self._rows["p_max_at"].append(tuple(state.p_max_at))
         info = state.info or {}

@@ -42,10 +42,11 @@ What each condition gets wrong:
   the film content in the cavitated region as an unknown; not in femehl yet.
 
 A model is a class with ``name``, ``changes_step`` (False: post-processing only, so the
-paper's FD reference accepts it), ``columns`` (the summary.csv columns it adds, read from
-``state.info``), ``note`` (how the reported fields are to be read), and the methods
-:meth:`check_scene`, :meth:`fixed`, :meth:`lagged_pressure`, :meth:`initial_info` and
-:meth:`finish` the stepper calls (:class:`femehl.core.stepper.LaggedStepper`).
+paper's FD reference accepts it), ``clips_pressure`` (the pictures say "clipped"),
+``columns`` (the summary.csv columns it adds, read from ``state.info``), ``note`` (how
+the reported fields are to be read), ``field_data`` (integer field data of the series),
+and the methods ``check_scene``, ``fixed``, ``lagged_pressure``, ``initial_info`` and
+``finish`` the stepper calls (:class:`femehl.core.stepper.LaggedStepper`).
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ __all__ = [
     "CAVITATION_COLUMNS",
     "HalfSommerfeld",
     "cavitation_columns",
+    "clips_pressure",
     "ReynoldsCavitation",
     "cavitation_model",
     "check_cavitation",
@@ -83,6 +85,7 @@ class _Model:
 
     name = ""
     changes_step = True
+    clips_pressure = False  # the reported pressure is the solved one clipped at 0
     columns: tuple = ()
     note = ""
     field_data: dict = {}  # integer field data of the VTK series
@@ -201,6 +204,7 @@ class HalfSommerfeld(_Model):
 
     name = "half-sommerfeld"
     changes_step = False
+    clips_pressure = True
     columns = ("load_full", "cavitated_area")
     field_data = {"HalfSommerfeldClipped": 1}
     note = (
@@ -259,6 +263,12 @@ CAVITATION_COLUMNS = ("load_full", "cavitated_area", "full_film_source")
 def cavitation_model(name):
     """An instance of the registered model ``name``; None for None (full Sommerfeld)."""
     return None if name is None else CAVITATION_MODELS[check_cavitation(name)]()
+
+
+def clips_pressure(scene) -> bool:
+    """True when the scene's condition reports its pressure clipped (half-Sommerfeld)."""
+    model = cavitation_model(getattr(scene, "cavitation", None))
+    return model is not None and model.clips_pressure
 
 
 def cavitation_columns(scene) -> tuple:

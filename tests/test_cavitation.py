@@ -199,6 +199,10 @@ def test_half_sommerfeld_is_the_full_run_clipped():
     assert half.load[-1] > 1.03 * full.load[-1]  # the sub-ambient lobe no longer subtracts
     assert half.cavitated_area[-1] > 1.0 and np.isnan(getattr(full, "cavitated_area", np.nan))
     assert half.info["cavitation"] == "half-sommerfeld" and "clipped" in half.info["cavitation_note"]
+    dim = femehl.Dimensional(R=5e-3, G=1e5, eta=0.1, V_ss=1e-3, h_inf=2e-5, nu=0.5)
+    si, si_full = dim.result_table(half), dim.result_table(full)
+    assert np.allclose(si["cavitated_area"], half.cavitated_area * dim.length**2, rtol=1e-14)
+    assert np.allclose(si["load_full"], si_full["load"], rtol=1e-12) and "load_full" not in si_full
 
 
 def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):

@@ -333,3 +333,28 @@ def test_centreline_of_a_full_sommerfeld_run_shades_nothing(run):
     assert not any("cavitated" in lab for lab in fig.get_axes()[0].get_legend_handles_labels()[1])
     assert fig.get_axes()[1].get_yscale() == "log"
     matplotlib.pyplot.close(fig)
+
+
+def test_line_contact_shades_the_cavitated_interval():
+    """line.png of a line-contact run with the Reynolds condition: the held nodes of the
+    last state as one interval from the cavitation point to the outlet."""
+    from femehl.line import LineScene
+    from femehl.scene import Constant, Motion
+
+    sc = LineScene(
+        k=1e9,
+        beta=10.0,
+        motion=Motion(gap=Constant(0.2), velocity=Constant(1.0)),
+        L=2.0,
+        cavitation="reynolds",
+    )
+    res = femehl.solve(sc, t_end=2.0, dt=0.05, n_elements=100, estimate=False, linear_solver="lu")
+    fig = plots.line_figure(res)
+    ax = fig.get_axes()[0]
+    assert any(lab.startswith("cavitated (p held at 0)") for lab in ax.get_legend_handles_labels()[1])
+    ((a, b),) = [_span(p) for p in ax.patches]
+    x = res.disc.x
+    held = x[res.disc.expand((res.final.p_aux < 0).astype(float)) > 0]  # p_aux: free nodes
+    assert a <= held.min() and held.max() <= b
+    assert b - a == pytest.approx(res.final.info["cavitated_area"], abs=2 * np.diff(x).max())
+    matplotlib.pyplot.close(fig)

@@ -90,9 +90,13 @@ def profile_times(result, wanted=(0.5, 0.8, 1.0, 1.5, 2.0, 5.0)):
 _CAV_SHADE = {"color": "0.8", "alpha": 0.6, "lw": 0, "zorder": 0}
 
 
+def _cavitation_label(clipped: bool) -> str:
+    return "cavitated (p < 0 clipped)" if clipped else "cavitated (p held at 0)"
+
+
 def cavitation_label(snap) -> str:
     """The legend entry of the cavitated region of a Snapshot."""
-    return "cavitated (p < 0 clipped)" if snap.clipped else "cavitated (p held at 0)"
+    return _cavitation_label(snap.clipped)
 
 
 def cavitated_intervals(x, flag) -> list[tuple[float, float]]:
@@ -514,7 +518,15 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
 
 
 def line_png(result, path):
-    """p(x) and d(x) at a few stored times of a line-contact run."""
+    """p(x) and d(x) at a few stored times of a line-contact run (:func:`line_figure`)."""
+    return _save(_plt(), line_figure(result), path, 110)
+
+
+def line_figure(result):
+    """p(x) and d(x) at a few stored times of a line-contact run, the cavitated interval(s)
+    of the last one shaded (a run with a cavitation condition)."""
+    from .series import cavitated_nodes
+
     plt = _plt()
     states = list(result.states[:: max(1, len(result.states) // 6)])
     if states[-1] is not result.final:
@@ -529,9 +541,20 @@ def line_png(result, path):
     ax2.set_ylabel("d")
     ax2.set_xlabel("x  (cylinder slides toward +x)")
     ax1.legend(fontsize=7, ncol=2)
+    cav = cavitated_nodes(result.disc, result.final)
+    if cav is not None:
+        spans = cavitated_intervals(result.disc.x, cav)
+        from ..cavitation import clips_pressure
+
+        label = _cavitation_label(clips_pressure(result.scene))
+        for k, (a, b) in enumerate(spans):
+            for ax in (ax1, ax2):
+                lab = f"{label}, t = {result.final.t:.3g}" if k == 0 and ax is ax1 else None
+                ax.axvspan(a, b, label=lab, **_CAV_SHADE)
+    ax1.legend(fontsize=7, ncol=2)
     sc = result.scene
     fig.suptitle(f"cylinder on Winkler foundation: k = {sc.k:g}, beta = {sc.beta:g}")
-    return _save(plt, fig, path, 110)
+    return fig
 
 
 def _history(result, path):

@@ -172,10 +172,9 @@ def snapshot(disc, state) -> Snapshot:
         cells = full_cells
     L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
     fmin, at = state.film_min, tuple(state.film_min_at)
-    from ..cavitation import cavitation_model
+    from ..cavitation import clips_pressure
 
-    model = cavitation_model(getattr(getattr(disc, "scene", None), "cavitation", None))
-    clipped = model is not None and bool(model.field_data.get("HalfSommerfeldClipped"))
+    clipped = clips_pressure(getattr(disc, "scene", None))
     return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav, clipped)
 
 

@@ -88,7 +88,9 @@ def main():
         "field's, with the full-Sommerfeld load of the same solution beside it (load before "
         "clipping); its cavitated area is that of the clipped nodes. Full-film source: the "
         "Reynolds condition's multiplier summed over the held nodes, the volume per unit time "
-        "it adds to the full-film balance (the cavity's gas intake, see "
+        "it adds to the full-film balance (the liquid created where the film reforms plus the "
+        "cavity's gas growth and outflow through the rim; here mostly the gas leaving through "
+        "the rim, see "
         "`femehl.cavitation.ReynoldsCavitation`). Most negative pressure: the lowest stored over "
         "every step, relative to the peak (full Sommerfeld: its sub-ambient lobe; Reynolds: the "
         "one-step transient of a node joining the set; half-Sommerfeld: 0).",

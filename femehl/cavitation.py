@@ -36,8 +36,9 @@ What each condition gets wrong:
   continuous where the film ruptures and mass is conserved there; where the film
   reforms it is not (no jump condition: mass is created or destroyed), and the film
   content of the cavitated region is not known.  The multiplier on the held rows is the
-  volume the condition supplies to the full-film balance, the cavity's gas intake
-  (``info["full_film_source"]``, see :class:`ReynoldsCavitation`);
+  volume the condition supplies to the full-film balance: the liquid created where the
+  film reforms, plus the cavity's gas growth and outflow (``info["full_film_source"]``,
+  see :class:`ReynoldsCavitation`);
 * **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): the mass-conserving model, carrying
   the film content in the cavitated region as an unknown; not in femehl yet.
 
@@ -137,17 +138,23 @@ class ReynoldsCavitation(_Model):
     outflow - inflow`` through the rim (``psi = sum_free phi_i``, 1 but on the rim's
     elements), the check ``tests/test_cavitation.py`` makes.
 
-    It is *not* the liquid the condition creates.  The cavitated region is counted as
-    full here, but it holds liquid and gas: if the liquid there were conserved (the JFO
-    transport ``d(theta d)/dt + div(-V theta d e_x) = 0``), subtracting it from the
-    full-film balance leaves ``d(v)/dt + div(-V v e_x) = s`` for the gas ``v = (1 -
-    theta) d``: ``full_film_source`` is the rate at which the cavity takes in gas (the
-    diverging gap behind the contact), not a liquid error.  The Reynolds condition's own
-    liquid error is at reformation (where the cavity closes, no jump condition), and
-    measuring it needs the film content ``theta`` of the cavity, which only a
-    mass-conserving model carries.  Steady 1-D slider, the cavity open to the outlet:
-    ``full_film_source = V (d(-L) - d_c)`` (the gap's Couette flux leaving minus that at
-    rupture, ``d_c`` the film there): all of it gas leaving through the outlet.
+    What it measures.  The cavitated region holds liquid and gas, and the balance above
+    counts it as full.  Let the liquid there be carried by the sliding surface and conserved
+    (as JFO has it: ``d(c)/dt + div(-V c e_x) = 0`` for the content ``c = theta d``, and
+    ``theta = 1`` where the film ruptures).  Subtracting that from the full-film balance
+    over the cavitated region splits the source into three parts:
+
+        full_film_source = (liquid created where the film reforms)
+                           + d/dt (gas volume of the cavity) + (gas flowing out through the rim).
+
+    The rupture boundary adds nothing (``dp/dn = 0``, ``theta = 1``): there the Reynolds
+    condition conserves mass.  At a steady state whose cavity closes inside the domain, the
+    source is exactly the liquid the condition creates where the film reforms (no jump
+    condition).  In the paper case the cavity behind the contact opens to the rim, and the
+    source is mostly the gas leaving there.  It then depends on L and, to first order, on the
+    size of the rim's elements, where the gap is steep.  Steady 1-D slider, the cavity open to
+    the outlet: ``full_film_source = V (d(-L) - d_c)``, with ``d_c`` the film at rupture.
+    That is the gap's Couette flux leaving minus the liquid's, and all of it is gas.
     """
 
     name = "reynolds"

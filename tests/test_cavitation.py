@@ -238,6 +238,13 @@ def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
     toml = tmp_path / "s.toml"
     toml.write_text(src.replace("[fluid]\n", '[fluid]\ncavitation = "half-sommerfeld"\n'))
     assert load_scene_file(toml)[0].cavitation == "half-sommerfeld"
+    from femehl.sweeps import SweepError, plan_sweep
+
+    run = {"t_end": 0.2, "dt": 0.1, "mesh": "coarse"}
+    plan = plan_sweep(None, {"fluid.cavitation": [None, "reynolds", "half-sommerfeld"]}, run=run)
+    assert [c.scene.cavitation for c in plan.cases] == [None, "reynolds", "half-sommerfeld"]
+    with pytest.raises(SweepError, match="imposed-gap run"):
+        plan_sweep(None, {"fluid.cavitation": ["half-sommerfeld"], "motion.load": [0.3]}, run=run)
 
 
 def test_full_film_source_closes_the_flux_balance():

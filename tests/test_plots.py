@@ -256,6 +256,8 @@ def test_line_contact_history_and_no_maps(tmp_path):
     assert (tmp_path / "history.png").stat().st_size > 10_000
     with pytest.raises(OutputError, match="line-contact run has no maps"):
         plots.plot_maps(tmp_path)
+    with pytest.raises(OutputError, match="maps and the centreline need a 2-D mesh"):
+        plots.plot_centreline(tmp_path)
 
 
 def test_cli_animate_needs_stored_fields(tmp_path, capsys):

@@ -103,8 +103,9 @@ def _triangles(cells):
             owner += [at + np.arange(c.shape[0])] * 2
         else:
             raise OutputError(
-                f"maps need a 2-D mesh (triangles or quads), this run has {kind!r} cells: "
-                "a line-contact run has no maps; see its line.png and history.png."
+                f"maps and the centreline need a 2-D mesh (triangles or quads), this run has "
+                f"{kind!r} cells: a line-contact run has no maps; see its line.png (p and d "
+                "along x, the cavitated interval shaded) and history.png."
             )
         at += c.shape[0]
     return np.vstack(tris), np.concatenate(owner)

@@ -110,7 +110,29 @@ class _Model:
         return dict.fromkeys(self.columns, 0.0)
 
     def finish(self, stepper, op, rhs, p, new, fixed):
-        """The state after the solve (``new`` built from the solved ``p``)."""
+        """The state the step returns, from the one built from the solved pressure.
+
+        Parameters
+        ----------
+        stepper : femehl.core.stepper.LaggedStepper
+            The stepper (``stepper.g``: load weights, ``stepper.disc``).
+        op : femehl.core.linsolve.StepOperator
+            The step's operator *without* the held rows replaced.
+        rhs : ndarray
+            Its right-hand side without the ``-G h`` part (``A p - b = D p + G d - rhs``).
+        p : ndarray
+            The solved pressure unknowns.
+        new : femehl.stepping.State
+            The state built from ``p`` (film, deflection, load, extremes).
+        fixed : ndarray of int
+            The rows held at ``p = 0`` in this step.
+
+        Returns
+        -------
+        femehl.stepping.State
+            ``new`` with the condition's ``p_aux``, ``info`` figures and, for a condition
+            that reports otherwise, its reported fields.
+        """
         raise NotImplementedError
 
 

@@ -303,3 +303,52 @@ def test_summary_columns_series_and_restart(tmp_path):
     assert cols["half-sommerfeld"] == COLUMNS + ("load_full", "cavitated_area")
     text = sorted((tmp_path / "half-sommerfeld-a").glob("fields_*.vtu"))[-1].read_text(errors="ignore")
     assert "half-Sommerfeld: negative pressures clipped after the solve" in text
+
+
+@dataclasses.dataclass(frozen=True)
+class _TwoConstrictions(LineScene):
+    """The cylinder with a bump downstream of its minimum (at x = -1.2, film 0.22): the film
+    ruptures behind the minimum and reforms at the bump -- a cavity inside the domain."""
+
+    @staticmethod
+    def shape(x):
+        x = np.asarray(x, dtype=float)
+        return 0.5 * x * x - 0.7 * np.exp(-(((x + 1.2) / 0.2) ** 2))
+
+
+def test_full_film_source_of_a_closed_cavity_is_the_liquid_created_where_the_film_reforms():
+    """Steady, two cavities: one closed between the minimum and the bump, one open to the
+    outlet.  In the film regions the flux ``-J`` is one constant each (``q1`` upstream,
+    ``q2`` between the cavities).  The closed cavity's multipliers sum to ``q2 - q1``: the
+    liquid entering it at rupture is ``q1`` (the Couette flux of the film there, ``dp/dx =
+    0``: nothing created at rupture), the film after it carries ``q2``, so ``q2 - q1`` is
+    what the condition creates where the film reforms.  The open cavity's sum is ``V d(-L)
+    - q2``, the gap's Couette flux leaving minus the liquid's: gas."""
+    sc = _TwoConstrictions(
+        k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L, cavitation="reynolds"
+    )
+    res = femehl.solve(
+        sc, t_end=4.0, dt=0.05, n_elements=400, grading="uniform", estimate=False, linear_solver="lu"
+    )
+    s, disc = res.final, res.disc
+    assert np.array_equal(res.states[-2].p, s.p)  # steady: the set and the field settled
+    x, h = disc.x, np.diff(disc.x)
+    lam = np.where(s.p_aux < 0, -s.p_aux, 0.0)  # the multipliers of the held (free) nodes
+    held = disc.expand((s.p_aux < 0).astype(float)) > 0
+    J = -BETA * s.d**3 * np.diff(s.p) / h - V * s.d  # element fluxes (steady: d* = d)
+    lam_nodes = disc.expand(lam)
+    exit_ = held & (x < -1.0)
+    closed = held & (x > -1.0)
+    assert exit_.any() and closed.any() and x[closed].max() < 0 < x[~held].max()
+    film = ~(held[:-1] | held[1:])  # elements between free, not held nodes
+    xe = 0.5 * (x[:-1] + x[1:])
+    up, between = film & (xe > x[closed].max()), film & (xe < x[closed].min()) & (xe > x[exit_].max())
+    q1, q2 = -J[up], -J[between]
+    assert np.ptp(q1) < 1e-10 * q1.mean() and np.ptp(q2) < 1e-10 * q2.mean()  # conserved
+    q1, q2 = q1.mean(), q2.mean()
+    assert lam_nodes[closed].sum() == pytest.approx(q2 - q1, rel=1e-9)
+    assert lam_nodes[exit_].sum() == pytest.approx(V * s.d[0] - q2, rel=1e-9)
+    assert s.info["full_film_source"] == pytest.approx(V * s.d[0] - q1, rel=1e-9)
+    assert abs(q2 - q1) > 0.01 * q1  # the Reynolds condition does create (or destroy) liquid
+    k = int(np.flatnonzero(closed)[-1])  # the rupture: the film's flux is its Couette flux
+    assert q1 == pytest.approx(V * s.d[k], rel=0.02)

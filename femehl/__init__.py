@@ -42,6 +42,7 @@ from .scene import (
     Winkler,
 )
 from .stepping import State, march
+from .substrates import Viscoelastic
 from .sweeps import sweep
 from .viscosity import Barus, Roelands
 
@@ -74,6 +75,7 @@ __all__ = [
     "HalfSpace",
     "Rigid",
     "Winkler",
+    "Viscoelastic",
     "Fluid",
     "Motion",
     "Domain",

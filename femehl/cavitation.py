@@ -109,7 +109,7 @@ class _Model:
         """The columns' values at p = 0 (the initial state)."""
         return dict.fromkeys(self.columns, 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
         """The state the step returns, from the one built from the solved pressure.
 
         Parameters
@@ -126,6 +126,9 @@ class _Model:
             The state built from ``p`` (film, deflection, load, extremes).
         fixed : ndarray of int
             The rows held at ``p = 0`` in this step.
+        scale : float, default: 1.0
+            The factor ``op.G`` carries (a viscoelastic step's ``J_eff``): the terms' film
+            operator is ``op.G / scale``.
 
         Returns
         -------
@@ -194,7 +197,7 @@ class ReynoldsCavitation(_Model):
             return np.zeros(0, dtype=np.int64)
         return np.flatnonzero(np.asarray(y) < 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
         """``p_aux = y``: ``p`` off the held set, ``-(A p - b)`` on it (the multiplier of the
         unmasked system): the next step's set is ``{y < 0}``; area, extremes and the mass
         source go to ``info``."""
@@ -202,7 +205,7 @@ class ReynoldsCavitation(_Model):
         info = dict(new.info)
         lam = np.zeros(0)
         if fixed.size:  # the residual of the held rows only
-            lam = op.D[fixed] @ p + op.G[fixed] @ new.d - rhs[fixed]
+            lam = op.D[fixed] @ p + (op.G[fixed] @ new.d) / scale - rhs[fixed]
             y[fixed] = -lam
         g = stepper.g
         info["cavitated_area"] = float(g[y < 0.0].sum())
@@ -260,7 +263,7 @@ class HalfSommerfeld(_Model):
         y = getattr(state, "p_aux", None)
         return np.asarray(state.p)[free_index] if y is None else np.asarray(y)
 
-    def finish(self, stepper, op, rhs, p, new, fixed):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
         """Clip: ``p``, ``load``, ``p_max`` of ``max(p, 0)``; ``p_aux`` the full ``p``."""
         disc = stepper.disc
         clipped = np.maximum(p, 0.0)

@@ -189,6 +189,11 @@ def load_scene_file(path) -> tuple[Scene, dict]:
     return scene_from_mapping(raw, path)
 
 
+def substrate_from_mapping(table: dict, path="[substrate]"):
+    """A substrate from a scene-file table such as ``{"kind": "winkler", "k": 2.0}``."""
+    return _build(SUBSTRATES, table, "substrate", path)
+
+
 def scene_from_mapping(raw: dict, path) -> tuple:
     """``(scene, run_options)`` of a scene file's content already read (a dict of tables).
 

@@ -61,6 +61,8 @@ class State:
     hc_prev: float | None = None  # a free indenter's hc and velocity one step earlier
     hc_dot_prev: float | None = None
     p_aux: np.ndarray | None = None  # cavitation: p off the cavitated set, -multiplier on it
+    creep: np.ndarray | None = None  # viscoelastic substrate: delayed deflection q on the film points
+    creep_prev: np.ndarray | None = None  # q one step earlier (two-step schemes)
 
 
 class Stepper(Protocol):

@@ -53,6 +53,13 @@ def _nbytes(a) -> int:
     return 0
 
 
+def _deflection(rows_p, mem, points) -> np.ndarray:
+    """``-w`` at ``points`` from the compliance rows times p (viscoelastic: scaled, plus the
+    material's history there)."""
+    u = np.asarray(rows_p, dtype=float).ravel()
+    return u if mem is None else mem.scale * u + mem.offset_at(points)
+
+
 class LaggedStepper:
     """Advance a discretized scene by one lagged linear step.
 
@@ -113,6 +120,8 @@ class LaggedStepper:
         self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
         if self.cavitation is not None:
             self.cavitation.check_scene(scene)
+        memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
+        self.memory = None if memory is None else memory(disc)
         self._FC: dict[str, object] = {}
         self._rows_cache: dict[int, np.ndarray] = {}
         self.info = dict(disc.info)
@@ -158,8 +167,12 @@ class LaggedStepper:
             self.info[f"{term.name}_assembled"] = True
         return pair
 
-    def operator(self, ctx: StepContext):
-        """The step's :class:`StepOperator` and its right-hand side without the ``-G h`` part."""
+    def operator(self, ctx: StepContext, scale: float = 1.0):
+        """The step's :class:`StepOperator` and its right-hand side without the ``-G h`` part.
+
+        ``scale`` multiplies the compliance (``d = h + scale C p``; a viscoelastic step's
+        ``J_eff``): it scales the film coefficients, so ``op.G`` is ``scale`` times the
+        terms' ``G``."""
         D = None
         films = []
         rhs = np.zeros(self.disc.n)
@@ -168,7 +181,7 @@ class LaggedStepper:
             if c.matrix is not None:
                 D = c.matrix if D is None else D + c.matrix
             if c.film_coefficient != 0.0:
-                films.append((c.film_coefficient, *self._film_product(term)))
+                films.append((c.film_coefficient * scale, *self._film_product(term)))
             if c.rhs is not None:
                 rhs += c.rhs
         if D is None:
@@ -176,18 +189,21 @@ class LaggedStepper:
         return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
 
     # ---- states -------------------------------------------------------------------------
-    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, hc_dot=None) -> State:
+    def _state(
+        self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, hc_dot=None, mem=None
+    ) -> State:
         disc = self.disc
         if Cp is None:
             Cp = np.asarray(self.C @ p).ravel()
-        w = -Cp
-        d = hc + self.shape + Cp
+        defl = Cp if mem is None else mem.scale * Cp + mem.offset  # -w on the film points
+        w = -defl
+        d = hc + self.shape + defl
         p_full = disc.expand(p)
         i_min = int(np.argmin(d))
         i_max = int(np.argmax(p_full))
         info = dict(info or {})
-        info.update(self._probe(hc, p, Cp, float(d[i_min])))
-        film_center = hc + self.s0 + float(np.asarray(self.centre_row @ p).ravel()[0])
+        info.update(self._probe(hc, p, defl, float(d[i_min]), mem))
+        film_center = hc + self.s0 + float(_deflection(self.centre_row @ p, mem, self.origin)[0])
         # the reported minimum is the true minimum of the discrete film: film points, the
         # origin and the probed nodes (the central film is never below it)
         info["film_points_min"] = float(d[i_min])
@@ -218,7 +234,7 @@ class LaggedStepper:
             hc_dot=hc_dot,
         )
 
-    def _probe(self, hc, p, Cp, d_min):
+    def _probe(self, hc, p, defl, d_min, mem=None):
         """The exact film at the nodes where a cheap nodal estimate says it is thinnest.
 
         The estimate is ``hc + s(node) +`` the mean of ``C p`` over the elements around the
@@ -229,14 +245,14 @@ class LaggedStepper:
         avg = self.disc.node_average
         if avg is None:
             return {}
-        est = hc + self.disc.node_shape + avg @ Cp
+        est = hc + self.disc.node_shape + avg @ defl
         k = min(_ALWAYS_PROBED, est.size)
         near = np.argpartition(est, k - 1)[:k]
         thin = np.flatnonzero(est < _PROBE_FRACTION * d_min)
         thin = thin[np.argsort(est[thin])[:_MAX_PROBES]]
         nodes = np.union1d(near, thin)
         rows = self._node_rows(nodes)
-        exact = hc + self.disc.node_shape[nodes] + rows @ p
+        exact = hc + self.disc.node_shape[nodes] + _deflection(rows @ p, mem, self.disc.nodes[nodes])
         j = int(np.argmin(exact))
         return {
             "node_film_min": float(exact[j]),
@@ -260,7 +276,10 @@ class LaggedStepper:
         mo = self.scene.motion
         hc_dot = mo.hc_dot0 if mo.free else None
         info = self.cavitation.initial_info() if self.cavitation is not None else None
-        return self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
+        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
+        if self.memory is not None:  # the material at rest, unloaded
+            state = dataclasses.replace(state, creep=np.zeros(self.memory.size))
+        return state
 
     # ---- one step -----------------------------------------------------------------------
     def step(self, state: State, t_new: float, dt: float) -> State:
@@ -281,18 +300,23 @@ class LaggedStepper:
         ctx = StepContext(
             t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
         )
-        op, rhs = self.operator(ctx)
+        mem = None
+        if self.memory is not None:  # viscoelastic: d = h + offset + J_eff C p
+            mem = self.memory.step(state, t_new, dt, a0, a1, a2, mo.V)
+        scale = 1.0 if mem is None else mem.scale
+        shape = self.shape if mem is None else self.shape + mem.offset
+        op, rhs = self.operator(ctx, scale)
         full, rhs_full = op, rhs
         fixed = cav.fixed(state) if cav is not None else np.zeros(0, dtype=np.int64)
         if fixed.size:  # cavitated nodes: p = 0 rows, the set from the previous step
             op = op.with_fixed(fixed)
             rhs = rhs.copy()
             rhs[fixed] = 0.0
-        G = op.G
+        G = op.G if mem is None else op.G / scale  # the terms' G (op.G carries the scale)
         hc_dot = None
         if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
             ones = np.ones(self.shape.size)
-            (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ self.shape, G @ ones], t_new)
+            (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ shape, G @ ones], t_new)
             g1, g2 = float(self.g @ x1), float(self.g @ x2)
             if mo.free:
                 hc, hc_dot = self._newton_row(state, t_new, dt, g1, g2, a0, a1, a2)
@@ -308,7 +332,7 @@ class LaggedStepper:
             Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
         else:
             hc = mo.hc(t_new)
-            ((p, Cp),) = self.solver.solve(op, [rhs - G @ (hc + self.shape)], t_new)
+            ((p, Cp),) = self.solver.solve(op, [rhs - G @ (hc + shape)], t_new)
         if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
@@ -320,12 +344,18 @@ class LaggedStepper:
         if self.solver.residuals:
             info["residual"] = max(self.solver.residuals)
         new = self._state(
-            state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info, hc_dot=hc_dot
+            state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info, hc_dot=hc_dot, mem=mem
         )
+        extra = {}
+        if mem is not None:
+            u = Cp if Cp is not None else np.asarray(self.C @ p).ravel()
+            extra.update(creep=mem.creep(u), creep_prev=state.creep)
         if hc_dot is not None:
-            new = dataclasses.replace(new, hc_prev=state.hc, hc_dot_prev=state.hc_dot)
+            extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
+        if extra:
+            new = dataclasses.replace(new, **extra)
         if cav is not None:  # the condition's part after the solve (unmasked system)
-            new = cav.finish(self, full, rhs_full, p, new, fixed)
+            new = cav.finish(self, full, rhs_full, p, new, fixed, scale)
         return new
 
     def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):

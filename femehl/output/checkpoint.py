@@ -91,6 +91,9 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
     arrays["p_aux"] = np.zeros(0) if state.p_aux is None else np.asarray(state.p_aux, dtype=float)
+    for k in ("creep", "creep_prev"):  # a viscoelastic substrate's internal variable
+        v = getattr(state, k)
+        arrays[k] = np.zeros(0) if v is None else np.asarray(v, dtype=float)
     for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
         v = getattr(state, k)
         arrays[k] = np.asarray(np.nan if v is None else v, dtype=float)
@@ -180,10 +183,17 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         hc_prev=_optional(a, "hc_prev", path),
         hc_dot_prev=_optional(a, "hc_dot_prev", path),
         p_aux=np.asarray(a["p_aux"], dtype=float) if "p_aux" in a and a["p_aux"].size else None,
+        creep=_optional_array(a, "creep"),  # a viscoelastic substrate's internal variable
+        creep_prev=_optional_array(a, "creep_prev"),
     )
     if reference is not None:
         check_state(state, reference, path)
     return state
+
+
+def _optional_array(a, key):
+    """An array entry absent from older checkpoints (or empty: not used by the run), else None."""
+    return np.asarray(a[key], dtype=float) if key in a and a[key].size else None
 
 
 def check_state(state: State, reference: State, path="checkpoint") -> None:
@@ -200,6 +210,15 @@ def check_state(state: State, reference: State, path="checkpoint") -> None:
             f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
             f"the discretization needs {np.shape(reference.d)}",
         )
+    for k in ("creep", "creep_prev"):
+        v = getattr(state, k)
+        want = np.shape(reference.creep) if reference.creep is not None else None
+        if v is not None and (np.shape(v) != want or not np.all(np.isfinite(v))):
+            raise _bad(
+                path,
+                f"its array {k!r} has shape {np.shape(v)} or non-finite values; the "
+                f"discretization's viscoelastic memory needs {want} finite values",
+            )
 
 
 # ---- run parameters ------------------------------------------------------------------------

@@ -23,6 +23,7 @@ it in TOML scene files (``[substrate] kind = "..."``).
 from .base import SUBSTRATES, Substrate, register_substrate
 from .halfspace import HalfSpace
 from .rigid import Rigid
+from .viscoelastic import Viscoelastic
 from .winkler import Winkler
 
-__all__ = ["Substrate", "SUBSTRATES", "register_substrate", "HalfSpace", "Winkler", "Rigid"]
+__all__ = ["Substrate", "SUBSTRATES", "register_substrate", "HalfSpace", "Winkler", "Rigid", "Viscoelastic"]

@@ -1,30 +1,75 @@
 """Cavitation conditions: where the film cannot hold a pressure below ambient.
 
 Every femehl run without one is full Sommerfeld (the pressure may go below ambient).
-``Fluid(beta, cavitation="reynolds")`` imposes the Reynolds (Swift-Stieber) condition
-``p >= 0``: the pressure is 0 on a cavitated set, the Reynolds equation holds elsewhere,
-and on the set its residual (the multiplier ``lambda = A p - b``) is non-negative.  The
-step stays ONE linear system: the set is lagged one step, like every other coefficient.
-The cavitated rows of the step's system are replaced by ``p_i = 0``
-(:meth:`femehl.core.linsolve.StepOperator.with_fixed`), and after the solve the
-complementarity variable ``y = p`` off the set and ``y = -lambda`` on it decides the next
-set: ``{y < 0}`` (a primal-dual active-set rule applied once per step).  At a steady
-state the set stops changing and the discrete Reynolds condition holds exactly; while it
-moves, a node can be negative for the one step before it joins the set (its value is
-reported as ``state.info["p_negative_min"]``).
+Two conditions are registered in :data:`CAVITATION_MODELS` (``Fluid(beta, cavitation=name)``,
+``LineScene(cavitation=name)``, ``[fluid] cavitation = name``):
 
-The Reynolds condition does not conserve mass where the film reforms (the
-Jakobsson-Floberg-Olsson model does; not in femehl yet).  Models are registered in
-:data:`CAVITATION_MODELS` by name.
+``"reynolds"`` (:class:`ReynoldsCavitation`)
+    The Reynolds (Swift-Stieber) condition ``p >= 0``: the pressure is 0 on a cavitated
+    set, the Reynolds equation holds elsewhere, and on the set its residual (the
+    multiplier ``lambda = A p - b``) is non-negative.  The step stays ONE linear system:
+    the set is lagged one step, like every other coefficient.  The cavitated rows of the
+    step's system are replaced by ``p_i = 0``
+    (:meth:`femehl.core.linsolve.StepOperator.with_fixed`), and after the solve the
+    complementarity variable ``y = p`` off the set and ``y = -lambda`` on it decides the
+    next set: ``{y < 0}`` (a primal-dual active-set rule applied once per step).  At a
+    steady state the set stops changing and the discrete Reynolds condition holds exactly;
+    while it moves, a node can be negative for the one step before it joins the set (its
+    value is reported as ``state.info["p_negative_min"]``).
+``"half-sommerfeld"`` (:class:`HalfSommerfeld`)
+    The classic comparison condition (Guembel): the step is the full-Sommerfeld step
+    (the same system, the same film and deflection), and the negative pressures are
+    clipped after the solve in what is reported: ``state.p``, ``p_max``, ``load`` and
+    the series.  The full-Sommerfeld load of the same solution stays beside it
+    (``info["load_full"]``, summary column ``load_full``).  It is refused under an
+    imposed load or a free indenter (see :class:`HalfSommerfeld`).
+
+What each condition gets wrong:
+
+* **full Sommerfeld** (no condition): the film holds a tension (sub-ambient pressure)
+  that a liquid cannot hold; the sub-ambient lobe behind the contact lowers the load;
+* **half-Sommerfeld**: the clipped field does not satisfy the Reynolds equation; at the
+  cavitation boundary the pressure gradient jumps, so the flux is discontinuous and mass
+  is created; film and deflection are those of the full-Sommerfeld pressure, not of the
+  pressure reported;
+* **Reynolds (Swift-Stieber)**: ``p = 0`` and ``dp/dn = 0`` at rupture, so the flux is
+  continuous where the film ruptures and mass is conserved there; where the film
+  reforms it is not (no jump condition: mass is created or destroyed), and the film
+  content of the cavitated region is not known.  The multiplier on the held rows is the
+  volume the condition supplies to the full-film balance: the liquid created where the
+  film reforms, plus the cavity's gas growth and outflow (``info["full_film_source"]``,
+  see :class:`ReynoldsCavitation`);
+* **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): the mass-conserving model, carrying
+  the film content in the cavitated region as an unknown; not in femehl yet.
+
+A model is a class with ``name``, ``changes_step`` (False: post-processing only, so the
+paper's FD reference accepts it), ``clips_pressure`` (the pictures say "clipped"),
+``columns`` (the summary.csv columns it adds, read from ``state.info``), ``note`` (how
+the reported fields are to be read), ``field_data`` (integer field data of the series),
+and the methods ``check_scene``, ``fixed``, ``lagged_pressure``, ``initial_info`` and
+``finish`` the stepper calls (:class:`femehl.core.stepper.LaggedStepper`).
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
 from .errors import SceneError
 
-__all__ = ["CAVITATION_MODELS", "ReynoldsCavitation", "check_cavitation", "register_cavitation"]
+__all__ = [
+    "CAVITATION_MODELS",
+    "CAVITATION_COLUMNS",
+    "HalfSommerfeld",
+    "cavitation_columns",
+    "clips_pressure",
+    "ReynoldsCavitation",
+    "cavitation_model",
+    "check_cavitation",
+    "check_cavitation_scene",
+    "register_cavitation",
+]
 
 #: name -> cavitation model class (``Fluid(cavitation=name)``)
 CAVITATION_MODELS: dict[str, type] = {}
@@ -36,11 +81,113 @@ def register_cavitation(cls):
     return cls
 
 
+class _Model:
+    """What the registered models share (see the module docstring)."""
+
+    name = ""
+    changes_step = True
+    clips_pressure = False  # the reported pressure is the solved one clipped at 0
+    columns: tuple = ()
+    note = ""
+    field_data: dict = {}  # integer field data of the VTK series
+
+    @staticmethod
+    def check_scene(scene) -> None:
+        """SceneError if the condition cannot be applied to ``scene``."""
+
+    @staticmethod
+    def fixed(state) -> np.ndarray:
+        """Free-node indices held at p = 0 in the step after ``state`` (none by default)."""
+        return np.zeros(0, dtype=np.int64)
+
+    @staticmethod
+    def lagged_pressure(state, free_index) -> np.ndarray:
+        """The pressure unknowns of ``state`` the next step's lagged coefficients use."""
+        return np.asarray(state.p)[free_index]
+
+    def initial_info(self) -> dict:
+        """The columns' values at p = 0 (the initial state)."""
+        return dict.fromkeys(self.columns, 0.0)
+
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+        """The state the step returns, from the one built from the solved pressure.
+
+        Parameters
+        ----------
+        stepper : femehl.core.stepper.LaggedStepper
+            The stepper (``stepper.g``: load weights, ``stepper.disc``).
+        op : femehl.core.linsolve.StepOperator
+            The step's operator *without* the held rows replaced.
+        rhs : ndarray
+            Its right-hand side without the ``-G h`` part (``A p - b = D p + G d - rhs``).
+        p : ndarray
+            The solved pressure unknowns.
+        new : femehl.stepping.State
+            The state built from ``p`` (film, deflection, load, extremes).
+        fixed : ndarray of int
+            The rows held at ``p = 0`` in this step.
+        scale : float, default: 1.0
+            The factor ``op.G`` carries (a viscoelastic step's ``J_eff``): the terms' film
+            operator is ``op.G / scale``.
+
+        Returns
+        -------
+        femehl.stepping.State
+            ``new`` with the condition's ``p_aux``, ``info`` figures and, for a condition
+            that reports otherwise, its reported fields.
+        """
+        raise NotImplementedError
+
+
 @register_cavitation
-class ReynoldsCavitation:
-    """``p >= 0`` (Swift-Stieber), the cavitated set lagged one step."""
+class ReynoldsCavitation(_Model):
+    """``p >= 0`` (Swift-Stieber), the cavitated set lagged one step.
+
+    Each step adds to ``state.info``: ``cavitated_area`` (the area, or in line contact
+    the length, of the nodes with ``y < 0``: ``sum_i g_i``, ``g`` the node weights of the
+    load), ``p_negative_min`` (the lowest pressure off the held set: the one-step
+    transient of a node joining it) and ``full_film_source``.
+
+    **The full-film source.**  Each row ``i`` of the step is the weak form of the film's
+    mass balance ``dd/dt + div J = 0`` (``J = -beta d^3 grad p - V d e_x``, normalized:
+    the film taken as full of liquid) tested with the hat function ``phi_i``:
+    ``r_i(p) = int phi_i dd/dt - int J . grad phi_i``, in flux units (normalized volume
+    per unit time).  A held row is replaced by ``p_i = 0``, so there the balance is met
+    only with a source: ``r_i(p) = lambda_i``, i.e. ``dd/dt + div J = s`` with
+    ``int phi_i s = lambda_i``.  The volume per unit time the condition supplies is
+
+        full_film_source = sum over the held nodes of lambda_i = sum_i (A p - b)_i
+
+    over the whole plane (twice the half disk's sum).  Added to the free rows (residual 0
+    to the solver's tolerance) it is the balance of the fields, ``d/dt int psi d +
+    outflow - inflow`` through the rim (``psi = sum_free phi_i``, 1 but on the rim's
+    elements), the check ``tests/test_cavitation.py`` makes.
+
+    What it measures.  The cavitated region holds liquid and gas, and the balance above
+    counts it as full.  Let the liquid there be carried by the sliding surface and conserved
+    (as JFO has it: ``d(c)/dt + div(-V c e_x) = 0`` for the content ``c = theta d``, and
+    ``theta = 1`` where the film ruptures).  Subtracting that from the full-film balance
+    over the cavitated region splits the source into three parts:
+
+        full_film_source = (liquid created where the film reforms)
+                           + d/dt (gas volume of the cavity) + (gas flowing out through the rim).
+
+    The rupture boundary adds nothing (``dp/dn = 0``, ``theta = 1``): there the Reynolds
+    condition conserves mass.  At a steady state whose cavity closes inside the domain, the
+    source is exactly the liquid the condition creates where the film reforms (no jump
+    condition).  In the paper case the cavity behind the contact opens to the rim, and the
+    source is mostly the gas leaving there.  It then depends on L and, to first order, on the
+    size of the rim's elements, where the gap is steep.  Steady 1-D slider, the cavity open to
+    the outlet: ``full_film_source = V (d(-L) - d_c)``, with ``d_c`` the film at rupture.
+    That is the gap's Couette flux leaving minus the liquid's, and all of it is gas.
+    """
 
     name = "reynolds"
+    columns = ("cavitated_area", "full_film_source")
+    note = (
+        "Reynolds (Swift-Stieber): p >= 0, the cavitated set lagged one step; mass is "
+        "conserved at rupture, not where the film reforms"
+    )
 
     @staticmethod
     def fixed(state) -> np.ndarray:
@@ -50,6 +197,117 @@ class ReynoldsCavitation:
             return np.zeros(0, dtype=np.int64)
         return np.flatnonzero(np.asarray(y) < 0.0)
 
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+        """``p_aux = y``: ``p`` off the held set, ``-(A p - b)`` on it (the multiplier of the
+        unmasked system): the next step's set is ``{y < 0}``; area, extremes and the mass
+        source go to ``info``."""
+        y = np.array(p, dtype=float)
+        info = dict(new.info)
+        lam = np.zeros(0)
+        if fixed.size:  # the residual of the held rows only
+            lam = op.D[fixed] @ p + (op.G[fixed] @ new.d) / scale - rhs[fixed]
+            y[fixed] = -lam
+        g = stepper.g
+        info["cavitated_area"] = float(g[y < 0.0].sum())
+        free = np.ones(p.size, dtype=bool)
+        free[fixed] = False
+        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
+        info["full_film_source"] = _plane_factor(stepper.disc) * float(lam.sum())
+        return dataclasses.replace(new, info=info, p_aux=y)
+
+
+@register_cavitation
+class HalfSommerfeld(_Model):
+    """Half-Sommerfeld (Guembel): the full-Sommerfeld step, negative pressures clipped after it.
+
+    ``state.p`` (and so the series, the maps, ``pressure_at``), ``state.load`` and
+    ``state.p_max`` are those of ``max(p, 0)``; ``state.d`` and ``state.w`` (film and
+    deflection) those of the full-Sommerfeld ``p``, which the next step uses
+    (``state.p_aux``) -- the run is the full-Sommerfeld run, only reported otherwise.
+    ``info["load_full"]`` is the full-Sommerfeld load ``g . p``, ``info["cavitated_area"]``
+    the area of the clipped nodes ``sum g_i`` over ``p_i < 0``.
+
+    Under an imposed load (or a free indenter) it is refused: the load row would have to
+    balance either the full-Sommerfeld load (then the reported, clipped load would not be
+    the load applied) or the clipped one (then film and deflection would no longer be
+    those of a solution of any Reynolds equation).  A tribologist imposing a load wants the
+    pressure that carries it: that is the Reynolds condition's.
+    """
+
+    name = "half-sommerfeld"
+    changes_step = False
+    clips_pressure = True
+    columns = ("load_full", "cavitated_area")
+    field_data = {"HalfSommerfeldClipped": 1}
+    note = (
+        "half-Sommerfeld: negative pressures clipped after the solve; the film and "
+        "deflection are those of the full-Sommerfeld solution; mass is not conserved and "
+        "the clipped field does not satisfy the Reynolds equation"
+    )
+
+    @staticmethod
+    def check_scene(scene) -> None:
+        motion = getattr(scene, "motion", None)
+        if motion is not None and motion.solves_hc:
+            what = "a free indenter (mass=...)" if motion.free else "an imposed load"
+            raise SceneError(
+                f'cavitation="half-sommerfeld" is a post-processing of an imposed-gap run; with '
+                f"{what} the load balance would hold for the full-Sommerfeld pressure, not for the "
+                'clipped one reported. Use cavitation="reynolds" (p >= 0 carries the load) or '
+                "impose the gap (Motion(gap=...))."
+            )
+
+    @staticmethod
+    def lagged_pressure(state, free_index) -> np.ndarray:
+        """The full-Sommerfeld pressure (``p_aux``; the clipped ``p`` before the first step)."""
+        y = getattr(state, "p_aux", None)
+        return np.asarray(state.p)[free_index] if y is None else np.asarray(y)
+
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+        """Clip: ``p``, ``load``, ``p_max`` of ``max(p, 0)``; ``p_aux`` the full ``p``."""
+        disc = stepper.disc
+        clipped = np.maximum(p, 0.0)
+        p_full = disc.expand(clipped)
+        i_max = int(np.argmax(p_full))
+        info = dict(new.info)
+        info["load_full"] = new.load
+        info["cavitated_area"] = float(stepper.g[p < 0.0].sum())
+        return dataclasses.replace(
+            new,
+            p=p_full,
+            load=float(stepper.g @ clipped),
+            p_max=float(p_full[i_max]),
+            p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
+            info=info,
+            p_aux=np.array(p, dtype=float),
+        )
+
+
+def _plane_factor(disc) -> float:
+    """2 for a half disk (its rows integrate over y >= 0), else 1: whole-plane figures."""
+    return 2.0 if getattr(disc, "half", False) else 1.0
+
+
+#: every column a cavitation model may add to summary.csv, in a fixed order
+CAVITATION_COLUMNS = ("load_full", "cavitated_area", "full_film_source")
+
+
+def cavitation_model(name):
+    """An instance of the registered model ``name``; None for None (full Sommerfeld)."""
+    return None if name is None else CAVITATION_MODELS[check_cavitation(name)]()
+
+
+def clips_pressure(scene) -> bool:
+    """True when the scene's condition reports its pressure clipped (half-Sommerfeld)."""
+    model = cavitation_model(getattr(scene, "cavitation", None))
+    return model is not None and model.clips_pressure
+
+
+def cavitation_columns(scene) -> tuple:
+    """The summary columns the scene's cavitation condition adds (``()``: full Sommerfeld)."""
+    model = cavitation_model(getattr(scene, "cavitation", None))
+    return () if model is None else tuple(model.columns)
+
 
 def check_cavitation(name):
     """``name`` if None or a registered model name, else SceneError naming the choices."""
@@ -58,3 +316,10 @@ def check_cavitation(name):
     raise SceneError(
         f"cavitation must be None (full Sommerfeld) or one of {sorted(CAVITATION_MODELS)}, got {name!r}."
     )
+
+
+def check_cavitation_scene(scene) -> None:
+    """SceneError if the scene's cavitation condition cannot be applied to it."""
+    model = cavitation_model(getattr(scene, "cavitation", None))
+    if model is not None:
+        model.check_scene(scene)

@@ -91,14 +91,17 @@ def _parser():
     pl = sub.add_parser("plot", help="draw a run folder's pictures again (any stored time)")
     pl.add_argument(
         "what",
-        choices=["history", "maps", "animation"],
+        choices=["history", "maps", "centreline", "animation"],
         help="history: load, hc, V, films against t; maps: film and pressure maps; "
+        "centreline: p and d along y = 0, the cavitated interval(s) shaded; "
         "animation: GIF of the maps",
     )
     pl.add_argument("folder", help="the run's output folder (femehl run --out)")
-    pl.add_argument("--t", type=float, help="maps: the stored time to draw (default: the last)")
+    pl.add_argument("--t", type=float, help="maps, centreline: the stored time to draw (default: the last)")
     pl.add_argument(
-        "--out", help="file to write (default: in the folder: history.png, maps[_tT].png, animation.gif)"
+        "--out",
+        help="file to write (default: in the folder: history.png, maps[_tT].png, "
+        "centreline_tT.png, animation.gif)",
     )
     pl.add_argument("--fps", type=int, default=8, help="animation: frames per second (default 8)")
     sw = sub.add_parser(
@@ -239,23 +242,26 @@ def _run(args, argv=()):
     _print_choice(res)
     for t in sorted({1.0, float(res.t[-1])}):
         if res.t[0] - 1e-9 <= t <= res.t[-1] + 1e-9:  # a resumed run starts at its checkpoint
+            cav = "".join(f", {c} {res.value_at(c, t):.5g}" for c in res.cavitation_columns)
             print(
                 f"  t = {t:g}: load {_with_error(res, 'load', t)}, central film "
-                f"{_with_error(res, 'film_center', t)}, minimum film {_with_error(res, 'film_min', t)}"
+                f"{_with_error(res, 'film_center', t)}, minimum film {_with_error(res, 'film_min', t)}" + cav
             )
     return 0
 
 
 def _plot(args) -> int:
-    """``femehl plot history|maps|animation FOLDER``: the picture, from the folder's files."""
+    """``femehl plot history|maps|centreline|animation FOLDER``: the picture, from the folder's files."""
     import time
 
-    from .output.plots import FOLDER_PLOTS
+    from .output.plots import FOLDER_PLOTS, TIMED_PLOTS
 
     t0 = time.perf_counter()
-    if args.what != "maps" and args.t is not None:
-        raise FemehlError("--t applies to femehl plot maps only (history and animation cover every time).")
-    own = {"maps": {"t": args.t}, "animation": {"fps": args.fps}}.get(args.what, {})
+    if args.what not in TIMED_PLOTS and args.t is not None:
+        raise FemehlError(
+            "--t applies to femehl plot maps and centreline only (history and animation cover every time)."
+        )
+    own = {"animation": {"fps": args.fps}}.get(args.what, {"t": args.t} if args.what in TIMED_PLOTS else {})
     path = FOLDER_PLOTS[args.what](args.folder, out=args.out, **own)
     print(f"femehl: wrote {path} in {time.perf_counter() - t0:.1f} s")
     return EXIT_DONE

@@ -15,8 +15,9 @@ obeys the 1-D normalized Reynolds equation, with the same conventions as the
 
 The cylinder slides toward +x; in its frame the substrate moves toward -x,
 so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
-gap, hc < 0 an indentation.  Cavitation is not modeled: p may go negative
-(at the exit), as in the 2-D solvers.  The paper checks its scheme on this
+gap, hc < 0 an indentation.  Without a cavitation condition (full Sommerfeld) p may
+go negative (at the exit), as in the 2-D solvers; ``cavitation="reynolds"`` or
+``"half-sommerfeld"`` as there (:mod:`femehl.cavitation`).  The paper checks its scheme on this
 problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
 steady sliding solution, which :mod:`femehl.line_steady` computes by
 quadrature and shooting.
@@ -107,7 +108,7 @@ class LineScene(SceneEffects):
         instead.  ``motion.load`` is accepted too (and moved here); give one of them.
     viscosity : femehl.Barus or femehl.Roelands, optional
         Pressure-dependent viscosity (:mod:`femehl.viscosity`); None: isoviscous.
-    cavitation : {None, "reynolds"}, optional
+    cavitation : {None, "reynolds", "half-sommerfeld"}, optional
         Cavitation condition (:mod:`femehl.cavitation`); None: full Sommerfeld.
     """
 
@@ -168,6 +169,9 @@ class LineScene(SceneEffects):
                 "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
                 "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
             )
+        from .cavitation import check_cavitation_scene
+
+        check_cavitation_scene(self)
         a = self.contact_halfwidth()
         if a is not None and self.L < 1.5 * a:
             raise SceneError(

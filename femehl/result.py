@@ -28,6 +28,9 @@ _STEPPING = ("dt", "error_estimate", "hc_dot")
 class Result:
     """Arrays with one entry per step (``t``, ``load``, ``film_center``, ...).
 
+    A run with a cavitation condition has its figures too (:attr:`cavitation_columns`:
+    ``cavitated_area``, ``full_film_source`` or ``load_full``), as in ``summary.csv``.
+
     Attributes
     ----------
     scene : femehl.scene.Scene
@@ -50,10 +53,26 @@ class Result:
     #: an expert run with adaptive steps has the time part only (``space``, ``total`` None)
     estimate: dict | None = None
 
+    def __post_init__(self):
+        from .cavitation import cavitation_columns
+
+        self._cavitation_columns = cavitation_columns(self.scene)
+        for k in self._cavitation_columns:
+            self._rows.setdefault(k, [])
+
+    @property
+    def cavitation_columns(self) -> tuple:
+        """The per-step figures the scene's cavitation condition adds (``()``: full
+        Sommerfeld): ``cavitated_area``, and ``full_film_source`` (Reynolds) or ``load_full``
+        (half-Sommerfeld), see :mod:`femehl.cavitation`."""
+        return self._cavitation_columns
+
     def record(self, state: State, store_fields: bool = True) -> None:
         """Append one state's scalars (and its fields when ``store_fields``)."""
         for k in _SCALARS:
             self._rows[k].append(float(getattr(state, k)))
+        for k in self.cavitation_columns:  # NaN where a state does not carry it
+            self._rows[k].append(float((state.info or {}).get(k, np.nan)))
         self._rows["film_min_at"].append(tuple(state.film_min_at))
         self._rows["p_max_at"].append(tuple(state.p_max_at))
         info = state.info or {}
@@ -181,6 +200,7 @@ class Result:
         at = np.asarray(self._rows["film_min_at"], dtype=float).reshape(-1, 2)
         pa = np.asarray(self._rows["p_max_at"], dtype=float).reshape(-1, 2)
         out.update(film_min_x=at[:, 0], film_min_y=at[:, 1], p_max_x=pa[:, 0], p_max_y=pa[:, 1])
+        out.update({k: getattr(self, k) for k in self.cavitation_columns})
         return out
 
     def impact(self) -> dict:
@@ -212,8 +232,9 @@ class Result:
 
     def value_at(self, name: str, t: float) -> float:
         """A per-step scalar (e.g. "load") at time ``t``, linear in time between steps."""
-        if name not in _SCALARS:
-            raise SceneError(f"unknown quantity {name!r}: value_at takes one of {list(_SCALARS)}.")
+        names = list(_SCALARS) + list(self.cavitation_columns)
+        if name not in names:
+            raise SceneError(f"unknown quantity {name!r}: value_at takes one of {names}.")
         ts = self.t
         t = float(t)
         tol = 1e-9 * max(1.0, abs(ts[-1]))

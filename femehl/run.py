@@ -332,6 +332,8 @@ def _stream(
         start = checkpoint.load_checkpoint(folder, reference=stepper.initial_state())
         _check_resume_time(start, t_end, None if tol is not None else dt)
     say(_terms(scene, stepper, t_end) + f"; set-up {time.perf_counter() - t0:.1f} s")
+    if "cavitation_note" in stepper.info:
+        say(f"femehl: cavitation: {stepper.info['cavitation_note']}")
 
     # ---- everything is checked: from here on the folder is written ----
     removed = prepare_folder(folder, overwrite=overwrite)

@@ -227,8 +227,9 @@ class Fluid:
 
     ``viscosity``: None (isoviscous, the paper's) or a pressure-viscosity model,
     :class:`femehl.Barus` or :class:`femehl.Roelands` (:mod:`femehl.viscosity`), lagged one
-    step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's) or
-    ``"reynolds"`` (``p >= 0``, :mod:`femehl.cavitation`).
+    step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's),
+    ``"reynolds"`` (``p >= 0``) or ``"half-sommerfeld"`` (the full-Sommerfeld run with its
+    negative pressures clipped in what is reported), see :mod:`femehl.cavitation`.
     """
 
     beta: float = 200.0
@@ -461,6 +462,9 @@ class Scene(SceneEffects):
                 "(the paper case uses h0 = +0.1)."
             )
         self._check_domain_holds_contact()
+        from .cavitation import check_cavitation_scene
+
+        check_cavitation_scene(self)
 
     def _check_domain_holds_contact(self):
         """The domain must reach well past the largest contact of the run, for any indenter.
@@ -795,12 +799,35 @@ class Dimensional:
     def velocity(self) -> float:
         return self.V_ss
 
+    @property
+    def area(self) -> float:
+        """Area scale = length^2 [m^2] (a cavitated area)."""
+        return self.length**2
+
+    @property
+    def volume_rate(self) -> float:
+        """Volume per unit time = length^2 height / time [m^3/s] (a film flux integral)."""
+        return self.length**2 * self.height / self.time
+
+    #: the quantities :meth:`to_si` converts
+    QUANTITIES: ClassVar[tuple] = (
+        "length",
+        "height",
+        "time",
+        "pressure",
+        "force",
+        "velocity",
+        "area",
+        "volume_rate",
+    )
+
     def to_si(self, quantity: str, value):
         """Multiply a normalized ``value`` by the scale of ``quantity``.
 
-        ``quantity`` is one of length, height, time, pressure, force, velocity.
+        ``quantity`` is one of :attr:`QUANTITIES`: length, height, time, pressure, force,
+        velocity, area, volume_rate.
         """
-        scales = {q: getattr(self, q) for q in ("length", "height", "time", "pressure", "force", "velocity")}
+        scales = {q: getattr(self, q) for q in self.QUANTITIES}
         if quantity not in scales:
             raise SceneError(f"unknown quantity {quantity!r}; choose one of {sorted(scales)}.")
         return np.asarray(value) * scales[quantity]
@@ -821,6 +848,10 @@ class Dimensional:
         "p_max": ("p_max", "pressure", "Pa"),
         "p_max_x": ("p_max_x", "length", "m"),
         "p_max_y": ("p_max_y", "length", "m"),
+        # a cavitation condition's figures (only where the result has them)
+        "load_full": ("load_full", "force", "N"),
+        "cavitated_area": ("cavitated_area", "area", "m2"),
+        "full_film_source": ("full_film_source", "volume_rate", "m3/s"),
     }
 
     def result_table(self, result) -> dict:
@@ -836,12 +867,15 @@ class Dimensional:
         dict of numpy arrays
             ``t`` [s], ``hc`` [m], ``load`` [N], ``film_center`` [m], ``film_min`` [m],
             ``film_min_x``, ``film_min_y`` [m], ``p_max`` [Pa], ``p_max_x``,
-            ``p_max_y`` [m]; the units are in :attr:`RESULT_COLUMNS`.
+            ``p_max_y`` [m], and a cavitation condition's ``load_full`` [N],
+            ``cavitated_area`` [m^2], ``full_film_source`` [m^3/s] where the result has
+            them; the units are in :attr:`RESULT_COLUMNS`.
         """
         s = result.summary()
         return {
             name: np.asarray(self.to_si(scale, s[col]), dtype=float)
             for name, (col, scale, _unit) in self.RESULT_COLUMNS.items()
+            if col in s
         }
 
     def scene(self, h0: float, t1: float | None = None, T: float | None = None, L: float = 2.0) -> Scene:

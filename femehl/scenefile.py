@@ -10,7 +10,9 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           | "cylinder" (R = 1 only): line contact, see below
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
     [fluid]               beta = 200.0
-                          cavitation = "reynolds" (optional: p >= 0; default full Sommerfeld)
+                          cavitation = "reynolds" (optional: p >= 0) | "half-sommerfeld"
+                          (negative pressures clipped after the full-Sommerfeld
+                          step; imposed gap only); default full Sommerfeld
     [fluid.viscosity]     optional: kind = "barus" (alpha) | "roelands" (alpha, p_r, Z),
                           normalized (see femehl.viscosity); isoviscous without it
     [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)

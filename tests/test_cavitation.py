@@ -161,3 +161,194 @@ def test_series_and_maps_show_the_cavitated_region(tmp_path):
     full = femehl.solve(sc, t_end=0.2, dt=0.1, mesh="coarse", estimate=False)
     full.save(tmp_path / "full")
     assert "cavitated" not in meshio.read(sorted((tmp_path / "full").glob("fields_*.vtu"))[-1]).point_data
+
+
+# ---- half-Sommerfeld and the per-step figures ---------------------------------------------
+def _p1_integral(disc, p_nodes):
+    """``int p dA`` of a nodal P1 field over the mesh triangles (whole plane): a triangle
+    integrates a linear field to its area times the mean of its vertex values."""
+    pts, t = disc.mesh.p, disc.mesh.t
+    a, b, c = (pts[:, t[k]] for k in range(3))
+    area = 0.5 * np.abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    return (2.0 if disc.half else 1.0) * float(np.sum(area * p_nodes[t].mean(axis=0)))
+
+
+def test_half_sommerfeld_is_the_full_run_clipped():
+    """Node by node the pressure is max(full-Sommerfeld p, 0), the film and deflection are
+    full Sommerfeld's (bit for bit: same system, direct solver), the load is the clipped
+    field's integral (by triangles, independently of the load weights) and ``load_full``
+    the full run's load; the cavitated area is the area of the clipped nodes' dual cells."""
+    sc = femehl.presets.paper_sphere()
+    hs = dataclasses.replace(sc, fluid=Fluid(sc.fluid.beta, cavitation="half-sommerfeld"))
+    opts = dict(t_end=2.5, dt=0.05, mesh="coarse", estimate=False, store_every=10, linear_solver="lu")
+    full, half = femehl.solve(sc, **opts), femehl.solve(hs, **opts)
+    assert len(full.states) == len(half.states) == 6
+    disc = half.disc
+    pts, t = disc.mesh.p, disc.mesh.t
+    a, b, c = (pts[:, t[k]] for k in range(3))
+    area = 0.5 * np.abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    dual = np.zeros(pts.shape[1])
+    np.add.at(dual, t.ravel(), np.tile(area / 3.0, 3))  # t.ravel() is row-major: vertex k of all
+    for f, s in zip(full.states, half.states, strict=True):
+        assert np.array_equal(s.d, f.d) and np.array_equal(s.w, f.w) and s.film_min == f.film_min
+        assert np.array_equal(s.p, np.maximum(f.p, 0.0))
+        assert s.load == pytest.approx(_p1_integral(disc, s.p), rel=1e-12)
+        assert s.info["load_full"] == pytest.approx(f.load, rel=1e-12)
+        assert s.info["cavitated_area"] == pytest.approx(2.0 * dual[f.p < 0].sum(), rel=1e-12, abs=1e-14)
+        assert s.p_max == f.p_max
+    assert half.load[-1] > 1.03 * full.load[-1]  # the sub-ambient lobe no longer subtracts
+    assert half.cavitated_area[-1] > 1.0 and np.isnan(getattr(full, "cavitated_area", np.nan))
+    assert half.info["cavitation"] == "half-sommerfeld" and "clipped" in half.info["cavitation_note"]
+    dim = femehl.Dimensional(R=5e-3, G=1e5, eta=0.1, V_ss=1e-3, h_inf=2e-5, nu=0.5)
+    si, si_full = dim.result_table(half), dim.result_table(full)
+    assert np.allclose(si["cavitated_area"], half.cavitated_area * dim.length**2, rtol=1e-14)
+    assert np.allclose(si["load_full"], si_full["load"], rtol=1e-12) and "load_full" not in si_full
+
+
+def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
+    """1-D: the cavitated length is where the full-Sommerfeld pressure is negative (its
+    zero crossing, interpolated, to the outlet); adaptive steps are the full run's; the FD
+    reference takes half-Sommerfeld (post-processing) but not Reynolds; an imposed load
+    is refused with half-Sommerfeld (the load row would balance the unclipped pressure)."""
+    full, half = _line(200, cavitation=None, t_end=1.0), _line(200, cavitation="half-sommerfeld", t_end=1.0)
+    x, p = full.disc.x, full.final.p
+    assert np.array_equal(half.final.p, np.maximum(p, 0.0))
+    k = np.flatnonzero((p[:-1] < 0) & (p[1:] >= 0))[-1]  # the last crossing from below
+    x0 = x[k] - p[k] * (x[k + 1] - x[k]) / (p[k + 1] - p[k])
+    assert half.final.info["cavitated_area"] == pytest.approx(x0 + L, abs=2 * np.diff(x).max())
+    sc = LineScene(k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L)
+    opts = dict(t_end=1.0, tol=1e-3, n_elements=100, estimate=False, linear_solver="lu")
+    a = femehl.solve(sc, **opts)
+    b = femehl.solve(dataclasses.replace(sc, cavitation="half-sommerfeld"), **opts)
+    assert np.array_equal(a.t, b.t)
+    paper = femehl.presets.paper_sphere()
+    fd = dict(t_end=0.2, dt=0.1, method="fd", dr=0.1, dtheta=math.pi / 12)
+    f = femehl.solve(paper, **fd)
+    h = femehl.solve(dataclasses.replace(paper, fluid=Fluid(200.0, cavitation="half-sommerfeld")), **fd)
+    assert np.array_equal(h.final.p, np.maximum(f.final.p, 0.0)) and np.array_equal(h.final.d, f.final.d)
+    with pytest.raises(SceneError, match="post-processing of an imposed-gap run"):
+        femehl.Scene(fluid=Fluid(200.0, cavitation="half-sommerfeld"), motion=Motion(gap=0.1, load=0.3))
+    with pytest.raises(SceneError, match='cavitation="reynolds"'):
+        LineScene(
+            motion=Motion(gap=Constant(HC), velocity=Constant(V)), load=0.5, cavitation="half-sommerfeld"
+        )
+    from femehl.scenefile import load_scene_file
+
+    src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
+    toml = tmp_path / "s.toml"
+    toml.write_text(src.replace("[fluid]\n", '[fluid]\ncavitation = "half-sommerfeld"\n'))
+    assert load_scene_file(toml)[0].cavitation == "half-sommerfeld"
+    from femehl.sweeps import SweepError, plan_sweep
+
+    run = {"t_end": 0.2, "dt": 0.1, "mesh": "coarse"}
+    plan = plan_sweep(None, {"fluid.cavitation": [None, "reynolds", "half-sommerfeld"]}, run=run)
+    assert [c.scene.cavitation for c in plan.cases] == [None, "reynolds", "half-sommerfeld"]
+    with pytest.raises(SweepError, match="imposed-gap run"):
+        plan_sweep(None, {"fluid.cavitation": ["half-sommerfeld"], "motion.load": [0.3]}, run=run)
+
+
+def test_full_film_source_closes_the_flux_balance():
+    """The Reynolds condition's ``full_film_source`` is the flux balance of the fields, computed
+    element by element: ``d/dt int psi d + J(L) - J(-L)`` with the element fluxes
+    ``J = -beta d*^3 p' - V d`` (``d*`` the lagged film of the step, ``psi`` the sum of the
+    free hat functions: half weight on the end elements) -- to round-off, while the set
+    moves and at the steady state.  There the cavity opens to the outlet: the full-film
+    volume the condition supplies is the gap's Couette flux leaving minus that at rupture,
+    ``V (d(-L) - d_c)``, to the size of the end element (it converges to it)."""
+    xc, _ = _slider()
+    d_c = _d(xc)
+    errs = []
+    for n in (100, 400):
+        res = _line(n)
+        x = res.disc.x
+        h = np.diff(x)
+        psi = h.copy()
+        psi[[0, -1]] *= 0.5
+        for k in (2, 6, len(res.states) - 1):
+            s0, s1 = res.states[k - 1], res.states[k]
+            J = -BETA * s0.d**3 * np.diff(s1.p) / h - V * s1.d
+            balance = np.sum(psi * (s1.d - s0.d)) / (s1.t - s0.t) + J[-1] - J[0]
+            assert s1.info["full_film_source"] == pytest.approx(balance, rel=1e-10)
+        assert res.full_film_source[-1] == pytest.approx(V * (res.final.d[0] - d_c), rel=2e-3)
+        errs.append(abs(res.full_film_source[-1] - V * (_d(-L) - d_c)))
+    assert errs[1] < 0.3 * errs[0] and errs[1] < 0.01 * V * (_d(-L) - d_c)
+
+
+def test_summary_columns_series_and_restart(tmp_path):
+    """summary.csv: full Sommerfeld keeps exactly its columns; a condition adds its own
+    (the Result's arrays); the half-Sommerfeld series is labelled; a resumed run writes
+    the same table as the whole run."""
+    from femehl.output.series import field_value
+    from femehl.output.table import COLUMNS, read_summary
+    from femehl.run import run_to_folder
+
+    base = dict(k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L)
+    opts = dict(dt=0.05, n_elements=100, linear_solver="lu", log=lambda *a: None, checkpoint_every=5)
+    cols = {}
+    for cav in (None, "reynolds", "half-sommerfeld"):
+        sc = LineScene(**base, cavitation=cav)
+        whole = run_to_folder(sc, tmp_path / f"{cav}-a", t_end=1.0, **opts)
+        run_to_folder(sc, tmp_path / f"{cav}-b", t_end=0.5, **opts)
+        run_to_folder(sc, tmp_path / f"{cav}-b", t_end=1.0, resume=True, **opts)
+        a, b = (read_summary(tmp_path / f"{cav}-{s}" / "summary.csv") for s in "ab")
+        cols[cav] = tuple(c for c in a if not c.startswith("err_"))
+        for c in cols[cav]:
+            assert np.array_equal(a[c], b[c]), c
+        for c in cols[cav][len(COLUMNS) :]:
+            assert np.allclose(a[c], getattr(whole, c), rtol=1e-9, atol=1e-12)
+        vtu = sorted((tmp_path / f"{cav}-a").glob("fields_*.vtu"))[-1]
+        assert field_value(vtu, "HalfSommerfeldClipped") == (1.0 if cav == "half-sommerfeld" else None)
+    assert cols[None] == COLUMNS
+    assert cols["reynolds"] == COLUMNS + ("cavitated_area", "full_film_source")
+    assert cols["half-sommerfeld"] == COLUMNS + ("load_full", "cavitated_area")
+    text = sorted((tmp_path / "half-sommerfeld-a").glob("fields_*.vtu"))[-1].read_text(errors="ignore")
+    assert "half-Sommerfeld: negative pressures clipped after the solve" in text
+
+
+@dataclasses.dataclass(frozen=True)
+class _TwoConstrictions(LineScene):
+    """The cylinder with a bump downstream of its minimum (at x = -1.2, film 0.22): the film
+    ruptures behind the minimum and reforms at the bump -- a cavity inside the domain."""
+
+    @staticmethod
+    def shape(x):
+        x = np.asarray(x, dtype=float)
+        return 0.5 * x * x - 0.7 * np.exp(-(((x + 1.2) / 0.2) ** 2))
+
+
+def test_full_film_source_of_a_closed_cavity_is_the_liquid_created_where_the_film_reforms():
+    """Steady, two cavities: one closed between the minimum and the bump, one open to the
+    outlet.  In the film regions the flux ``-J`` is one constant each (``q1`` upstream,
+    ``q2`` between the cavities).  The closed cavity's multipliers sum to ``q2 - q1``: the
+    liquid entering it at rupture is ``q1`` (the Couette flux of the film there, ``dp/dx =
+    0``: nothing created at rupture), the film after it carries ``q2``, so ``q2 - q1`` is
+    what the condition creates where the film reforms.  The open cavity's sum is ``V d(-L)
+    - q2``, the gap's Couette flux leaving minus the liquid's: gas."""
+    sc = _TwoConstrictions(
+        k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L, cavitation="reynolds"
+    )
+    res = femehl.solve(
+        sc, t_end=4.0, dt=0.05, n_elements=400, grading="uniform", estimate=False, linear_solver="lu"
+    )
+    s, disc = res.final, res.disc
+    assert np.array_equal(res.states[-2].p, s.p)  # steady: the set and the field settled
+    x, h = disc.x, np.diff(disc.x)
+    lam = np.where(s.p_aux < 0, -s.p_aux, 0.0)  # the multipliers of the held (free) nodes
+    held = disc.expand((s.p_aux < 0).astype(float)) > 0
+    J = -BETA * s.d**3 * np.diff(s.p) / h - V * s.d  # element fluxes (steady: d* = d)
+    lam_nodes = disc.expand(lam)
+    exit_ = held & (x < -1.0)
+    closed = held & (x > -1.0)
+    assert exit_.any() and closed.any() and x[closed].max() < 0 < x[~held].max()
+    film = ~(held[:-1] | held[1:])  # elements between free, not held nodes
+    xe = 0.5 * (x[:-1] + x[1:])
+    up, between = film & (xe > x[closed].max()), film & (xe < x[closed].min()) & (xe > x[exit_].max())
+    q1, q2 = -J[up], -J[between]
+    assert np.ptp(q1) < 1e-10 * q1.mean() and np.ptp(q2) < 1e-10 * q2.mean()  # conserved
+    q1, q2 = q1.mean(), q2.mean()
+    assert lam_nodes[closed].sum() == pytest.approx(q2 - q1, rel=1e-9)
+    assert lam_nodes[exit_].sum() == pytest.approx(V * s.d[0] - q2, rel=1e-9)
+    assert s.info["full_film_source"] == pytest.approx(V * s.d[0] - q1, rel=1e-9)
+    assert abs(q2 - q1) > 0.01 * q1  # the Reynolds condition does create (or destroy) liquid
+    k = int(np.flatnonzero(closed)[-1])  # the rupture: the film's flux is its Couette flux
+    assert q1 == pytest.approx(V * s.d[k], rel=0.02)

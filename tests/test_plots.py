@@ -222,7 +222,7 @@ def test_cli_plot_maps_default_name_in_the_folder(run):
     "argv,words",
     [
         (["plot", "maps", "{f}", "--t", "9"], "no stored fields at t = 9"),
-        (["plot", "history", "{f}", "--t", "1"], "--t applies to femehl plot maps only"),
+        (["plot", "history", "{f}", "--t", "1"], "--t applies to femehl plot maps and centreline only"),
         (["plot", "animation", "{f}", "--fps", "0"], "fps must be"),
         (["plot", "history", "{missing}"], "is not a folder"),
         (["plot", "maps", "{empty}"], "holds no femehl run"),
@@ -256,6 +256,8 @@ def test_line_contact_history_and_no_maps(tmp_path):
     assert (tmp_path / "history.png").stat().st_size > 10_000
     with pytest.raises(OutputError, match="line-contact run has no maps"):
         plots.plot_maps(tmp_path)
+    with pytest.raises(OutputError, match="maps and the centreline need a 2-D mesh"):
+        plots.plot_centreline(tmp_path)
 
 
 def test_cli_animate_needs_stored_fields(tmp_path, capsys):
@@ -271,3 +273,90 @@ def test_cli_run_animate(tmp_path):
     from PIL import Image
 
     assert Image.open(tmp_path / "animation.gif").n_frames == 3  # t = 0, 0.2, 0.4
+
+
+# ---- the centreline and the cavitated interval ------------------------------------------
+def test_cavitated_intervals_between_samples():
+    x = np.arange(10.0)
+    flag = np.array([1, 1, 0, 0, 1, 1, 1, 0, 0, 1], dtype=float)
+    assert plots.cavitated_intervals(x, flag) == [(0.0, 1.5), (3.5, 6.5), (8.5, 9.0)]
+    assert plots.cavitated_intervals(x, np.zeros(10)) == []
+    assert plots.cavitated_intervals(x, np.r_[np.nan, 0.8, np.full(8, np.nan)]) == [(0.5, 1.5)]
+
+
+def _span(patch):
+    """The x extent of an axvspan (a Rectangle in recent matplotlib, a Polygon before)."""
+    if hasattr(patch, "get_width"):
+        return patch.get_x(), patch.get_x() + patch.get_width()
+    x = np.asarray(patch.get_xy())[:, 0]
+    return x.min(), x.max()
+
+
+@pytest.mark.parametrize("condition", ["reynolds", "half-sommerfeld"])
+def test_centreline_shades_where_the_film_cavitates(tmp_path, condition):
+    """The one-time centreline (``femehl plot centreline``) shades the cavitated interval(s)
+    with a legend entry: it covers the flagged nodes on y = 0 and stops before the first
+    unflagged one, and the pressure there is 0 (held, or clipped)."""
+    import dataclasses
+
+    sc = femehl.presets.paper_sphere()
+    sc = dataclasses.replace(sc, fluid=femehl.Fluid(200.0, cavitation=condition))
+    res = femehl.solve(sc, t_end=2.5, dt=0.05, mesh="coarse", estimate=False, store_every=25)
+    res.save(tmp_path)  # centreline.png of several times, the last one's interval shaded
+    assert (tmp_path / "centreline.png").stat().st_size > 10_000
+    assert main(["plot", "centreline", str(tmp_path), "--t", "2.5"]) == 0
+    assert (tmp_path / "centreline_t2.5.png").stat().st_size > 10_000
+    snap = read_snapshot(tmp_path)
+    fig = plots.centreline_figure(snap)
+    ax_p, ax_d = fig.get_axes()
+    label = {"reynolds": "cavitated (p held at 0)", "half-sommerfeld": "cavitated (p < 0 clipped)"}[condition]
+    assert label in ax_p.get_legend_handles_labels()[1]
+    spans = [_span(p) for p in ax_p.patches]
+    assert spans and len(spans) == len(ax_d.patches)
+    on_line = np.abs(snap.points[:, 1]) < 1e-12
+    xs, flags = snap.points[on_line, 0], snap.cavitated[on_line]
+    order = np.argsort(xs)
+    xs, flags = xs[order], flags[order]
+    for a, b in spans:
+        inside = (xs > a) & (xs < b)
+        assert inside.any() and np.all(flags[inside] == 1.0)
+        assert np.all(np.abs(snap.pressure[on_line][order][inside]) <= 3e-3 * snap.pressure.max())
+        left, right = xs[xs < a], xs[xs > b]  # the neighbours outside are not cavitated
+        assert left.size == 0 or flags[xs == left.max()][0] == 0.0
+        assert right.size == 0 or flags[xs == right.min()][0] == 0.0
+    assert any(b < 0 for _, b in spans)  # behind the contact (the exit side)
+    matplotlib.pyplot.close(fig)
+
+
+def test_centreline_of_a_full_sommerfeld_run_shades_nothing(run):
+    _, folder = run
+    fig = plots.centreline_figure(read_snapshot(folder, 1.2))
+    assert not fig.get_axes()[0].patches
+    assert not any("cavitated" in lab for lab in fig.get_axes()[0].get_legend_handles_labels()[1])
+    assert fig.get_axes()[1].get_yscale() == "log"
+    matplotlib.pyplot.close(fig)
+
+
+def test_line_contact_shades_the_cavitated_interval():
+    """line.png of a line-contact run with the Reynolds condition: the held nodes of the
+    last state as one interval from the cavitation point to the outlet."""
+    from femehl.line import LineScene
+    from femehl.scene import Constant, Motion
+
+    sc = LineScene(
+        k=1e9,
+        beta=10.0,
+        motion=Motion(gap=Constant(0.2), velocity=Constant(1.0)),
+        L=2.0,
+        cavitation="reynolds",
+    )
+    res = femehl.solve(sc, t_end=2.0, dt=0.05, n_elements=100, estimate=False, linear_solver="lu")
+    fig = plots.line_figure(res)
+    ax = fig.get_axes()[0]
+    assert any(lab.startswith("cavitated (p held at 0)") for lab in ax.get_legend_handles_labels()[1])
+    ((a, b),) = [_span(p) for p in ax.patches]
+    x = res.disc.x
+    held = x[res.disc.expand((res.final.p_aux < 0).astype(float)) > 0]  # p_aux: free nodes
+    assert a <= held.min() and held.max() <= b
+    assert b - a == pytest.approx(res.final.info["cavitated_area"], abs=2 * np.diff(x).max())
+    matplotlib.pyplot.close(fig)

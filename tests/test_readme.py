@@ -68,6 +68,13 @@ def test_readme_block_runs(index, tmp_path, monkeypatch, capsys, paper_reference
         assert auto.value_at("film_min", 0.5) == pytest.approx(
             namespace["res"].value_at("film_min", 0.5), rel=0.04
         )
+    elif "cavitation=" in python_blocks()[index]:
+        # the cavitation block: half-Sommerfeld reports the clipped load (above the
+        # full-Sommerfeld one, whose sub-ambient lobe it drops) and a cavitated area; the
+        # Reynolds condition a cavitated area and a positive full-film source
+        (hs_load, hs_full, hs_area), (re_area, re_source) = _floats(out[0]), _floats(out[1])
+        assert hs_load > 1.02 * hs_full and hs_area > 1.0
+        assert re_area > 1.0 and re_source > 0.0
     else:
         # the Scene built field by field is the paper case of the first block
         assert namespace["scene"] == femehl.presets.paper_sphere()

@@ -215,14 +215,21 @@ def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float) -> floa
     """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (see the module doc)."""
     d = np.asarray(trial.d, dtype=float)
     err = float(np.max(np.abs(d - d_pred) / d)) if d.size else 0.0
-    scale = max(run.load_scale, abs(trial.load), LOAD_FLOOR)
-    return max(err, abs(trial.load - load_pred) / scale)
+    load = _load(trial)
+    scale = max(run.load_scale, abs(load), LOAD_FLOOR)
+    return max(err, abs(load - load_pred) / scale)
+
+
+def _load(state: State) -> float:
+    """The load of the step's own solution (half-Sommerfeld: before its clipping, so the
+    steps are those of the full-Sommerfeld run)."""
+    return float((state.info or {}).get("load_full", state.load))
 
 
 def _predict(levels, t):
     w = _lagrange([s.t for s in levels], t)
     d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels, strict=True))
-    load_pred = float(sum(wi * s.load for wi, s in zip(w, levels, strict=True)))
+    load_pred = float(sum(wi * _load(s) for wi, s in zip(w, levels, strict=True)))
     return d_pred, load_pred
 
 
@@ -413,7 +420,7 @@ def march_adaptive(
     order = _order(stepper)
 
     state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
-    run = _Run(dt=dt0, levels=[_restart(state)], load_scale=abs(state.load), film0=film_floor(state)[0])
+    run = _Run(dt=dt0, levels=[_restart(state)], load_scale=abs(_load(state)), film0=film_floor(state)[0])
     run.recent.append(state)
     yield state
     for stop in stops:
@@ -469,7 +476,7 @@ def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, d
             raise _floor_error(stepper, run, t_new, h, dt_min, fail)
         _reject(run, 1, max(RETRY_FACTOR * h, dt_min), fail.reason, t_new, h)
         return
-    run.load_scale = max(run.load_scale, abs(trial.load))
+    run.load_scale = max(run.load_scale, abs(_load(trial)))
     if start_step:
         run.levels.append(trial)
         run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0

@@ -115,10 +115,11 @@ class LaggedStepper:
         self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
         self.shape = disc.shape
         self.g = disc.load_weights
-        from ..cavitation import CAVITATION_MODELS
+        from ..cavitation import cavitation_model
 
-        cav = getattr(scene, "cavitation", None)
-        self.cavitation = None if cav is None else CAVITATION_MODELS[cav]()
+        self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
+        if self.cavitation is not None:
+            self.cavitation.check_scene(scene)
         memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
         self.memory = None if memory is None else memory(disc)
         self._FC: dict[str, object] = {}
@@ -139,6 +140,8 @@ class LaggedStepper:
                 "krylov_iterations": 0,
             }
         )
+        if self.cavitation is not None:  # how the reported fields are to be read
+            self.info.update(cavitation=self.cavitation.name, cavitation_note=self.cavitation.note)
         for term in self.terms:  # film products every step needs: formed here, once
             if getattr(term, "every_step", False):
                 self._film_product(term)
@@ -272,7 +275,8 @@ class LaggedStepper:
     def initial_state(self) -> State:
         mo = self.scene.motion
         hc_dot = mo.hc_dot0 if mo.free else None
-        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), hc_dot=hc_dot)
+        info = self.cavitation.initial_info() if self.cavitation is not None else None
+        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
         if self.memory is not None:  # the material at rest, unloaded
             state = dataclasses.replace(state, creep=np.zeros(self.memory.size))
         return state
@@ -289,7 +293,9 @@ class LaggedStepper:
         else:  # extrapolated coefficient, kept positive
             d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
             hist = a1 * state.d - a2 * state.d_prev
-        p_old = state.p[self.disc.free_index]
+        cav = self.cavitation
+        free_index = self.disc.free_index
+        p_old = state.p[free_index] if cav is None else cav.lagged_pressure(state, free_index)
         its0 = self.solver.info.get("krylov_iterations", 0)
         ctx = StepContext(
             t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
@@ -301,7 +307,7 @@ class LaggedStepper:
         shape = self.shape if mem is None else self.shape + mem.offset
         op, rhs = self.operator(ctx, scale)
         full, rhs_full = op, rhs
-        fixed = self.cavitation.fixed(state) if self.cavitation is not None else np.zeros(0, dtype=np.int64)
+        fixed = cav.fixed(state) if cav is not None else np.zeros(0, dtype=np.int64)
         if fixed.size:  # cavitated nodes: p = 0 rows, the set from the previous step
             op = op.with_fixed(fixed)
             rhs = rhs.copy()
@@ -346,21 +352,11 @@ class LaggedStepper:
             extra.update(creep=mem.creep(u), creep_prev=state.creep)
         if hc_dot is not None:
             extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
-        if self.cavitation is not None:
-            extra["p_aux"] = self._complementarity(full, rhs_full, p, new.d, fixed, new.info, scale)
-        return dataclasses.replace(new, **extra) if extra else new
-
-    def _complementarity(self, op, rhs, p, d, fixed, info, scale=1.0):
-        """``y = p`` off the cavitated set, ``-(A p - b)`` on it (the multiplier, unmasked
-        system): the next step's set is ``{y < 0}``; area and extremes go to ``info``."""
-        y = np.array(p, dtype=float)
-        if fixed.size:  # the residual of the held rows only
-            y[fixed] = rhs[fixed] - op.D[fixed] @ p - (op.G[fixed] @ d) / scale
-        info["cavitated_area"] = float(self.g[y < 0.0].sum())
-        free = np.ones(p.size, dtype=bool)
-        free[fixed] = False
-        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
-        return y
+        if extra:
+            new = dataclasses.replace(new, **extra)
+        if cav is not None:  # the condition's part after the solve (unmasked system)
+            new = cav.finish(self, full, rhs_full, p, new, fixed, scale)
+        return new
 
     def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):
         """hc and dhc/dt of a free indenter: ``m hc'' = load - force`` by the step's own

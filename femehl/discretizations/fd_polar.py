@@ -119,10 +119,14 @@ class FDDisc:
                 f"it needs an indenter symmetric in y; {type(scene.indenter).__name__} is not. "
                 "Use method='fe' (it meshes the full disk for such shapes)."
             )
-        if getattr(scene, "cavitation", None) is not None:
+        from ..cavitation import cavitation_model
+
+        cav = cavitation_model(getattr(scene, "cavitation", None))
+        if cav is not None and cav.changes_step:
             raise SceneError(
-                "the FD reference is the paper's full-Sommerfeld scheme: use method='fe' for a "
-                "cavitation condition."
+                "the FD reference is the paper's full-Sommerfeld scheme: use method='fe' for the "
+                f"{cav.name!r} cavitation condition (the FD reference takes 'half-sommerfeld', a "
+                "post-processing of its full-Sommerfeld step)."
             )
         if getattr(scene, "viscosity", None) is not None:
             raise SceneError(

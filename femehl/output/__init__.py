@@ -25,7 +25,7 @@ from .plots import (
 )
 from .series import SeriesWriter
 from .snapshot import Snapshot, read_snapshot, snapshot
-from .table import COLUMNS, SummaryWriter, add_error_columns, write_summary
+from .table import COLUMNS, SummaryWriter, add_error_columns, columns_for, write_summary
 
 __all__ = [
     "COLUMNS",
@@ -66,7 +66,10 @@ class RunWriter:
     def __init__(self, folder, disc, every: int = 10, *, summary=None, series=None):
         self.folder = pathlib.Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
-        self.summary = summary if summary is not None else SummaryWriter(self.folder / "summary.csv")
+        if summary is None:
+            columns = columns_for(getattr(disc, "scene", None))
+            summary = SummaryWriter(self.folder / "summary.csv", columns=columns)
+        self.summary = summary
         if series is None and every:
             series = SeriesWriter(self.folder, disc)
         self.series = series

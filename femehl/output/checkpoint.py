@@ -38,6 +38,7 @@ import zlib
 
 import numpy as np
 
+from ..cavitation import CAVITATION_COLUMNS
 from ..errors import CheckpointError, SceneError
 from ..stepping import State
 
@@ -96,6 +97,9 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
         v = getattr(state, k)
         arrays[k] = np.asarray(np.nan if v is None else v, dtype=float)
+    for k in CAVITATION_COLUMNS:  # a cavitation condition's per-step figures (summary columns)
+        if k in (state.info or {}):
+            arrays[f"info_{k}"] = np.asarray(float(state.info[k]))
     arrays["format"] = np.asarray(FORMAT)
     path = folder / CHECKPOINT
     _atomic_write(path, lambda fh: np.savez(fh, **arrays))
@@ -152,6 +156,7 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         floats = {k: _scalar(a, k, path) for k in _SCALARS if k != "step"}
         arrays = {k: np.asarray(a[k], dtype=float) for k in _ARRAYS + ("film_min_at", "p_max_at", "d_prev")}
         step = _scalar(a, "step", path, int)
+        cav_info = {k: _scalar(a, f"info_{k}", path) for k in CAVITATION_COLUMNS if f"info_{k}" in a}
     except (TypeError, ValueError) as exc:
         raise _bad(path, f"an entry has the wrong type ({exc})") from None
     if step < 0 or not math.isfinite(floats["t"]) or floats["t"] < 0:
@@ -170,7 +175,7 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         film_min_at=tuple(arrays["film_min_at"].tolist()),
         p_max=floats["p_max"],
         p_max_at=tuple(arrays["p_max_at"].tolist()),
-        info={"resumed": True},
+        info={"resumed": True, **cav_info},
         d_prev=arrays["d_prev"] if has_prev else None,
         dt_prev=None if math.isnan(dt_prev) else dt_prev,
         # absent from checkpoints written before free indenters
@@ -366,6 +371,33 @@ def _cut_summary(path: pathlib.Path, t_ckpt: float) -> None:
         fh.truncate(keep)
 
 
+def _align_summary(path: pathlib.Path, columns: tuple) -> None:
+    """Make the header of a summary to be appended to read ``columns``.
+
+    A finished run's file may carry the error-estimate columns (added at its end: they do
+    not describe the longer run, and rows appended without them would not fit) and a file
+    written before a column existed lacks it (older femehl, e.g. ``cavitated_area``): the
+    rows are rewritten with exactly ``columns``, an absent cell left empty (NaN when read).
+    """
+    import csv
+
+    if not path.is_file():
+        return
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows or tuple(rows[0]) == tuple(columns):
+        return
+    where = {c: i for i, c in enumerate(rows[0])}
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(columns)
+        for r in rows[1:]:
+            w.writerow([r[where[c]] if c in where and where[c] < len(r) else "" for c in columns])
+    os.replace(tmp, path)
+    logger.info("femehl: %s rewritten with the columns of the resumed run", path)
+
+
 def _continue_series(writer, t_ckpt: float) -> None:
     """Point a SeriesWriter at the files present: index up to ``t_ckpt``, numbering after all."""
     from .series import scan_series
@@ -393,8 +425,13 @@ def resume_writer(folder, disc, every: int, t_ckpt: float):
     folder = pathlib.Path(folder)
     summary = folder / "summary.csv"
     _cut_summary(summary, t_ckpt)
+    from .table import columns_for
+
+    columns = columns_for(getattr(disc, "scene", None))
+    _align_summary(summary, columns)
     series = None
     if every:
         series = SeriesWriter(folder, disc)
         _continue_series(series, t_ckpt)
-    return RunWriter(folder, disc, every, summary=SummaryWriter(summary, append=True), series=series)
+    writer = SummaryWriter(summary, append=True, columns=columns)
+    return RunWriter(folder, disc, every, summary=writer, series=series)

@@ -10,7 +10,11 @@
   :data:`WINDOW` contact radii (the contact: where p > 5 % of its peak), the minimum film
   marked, the cavitated region hatched (a run with a cavitation condition); a half-disk
   run is shown mirrored (the whole contact);
-* :func:`centreline_png` (``centreline.png``): p and d along y = 0 at several times;
+* :func:`centreline_png` (``centreline.png``): p and d along y = 0 at several times, the
+  cavitated interval(s) of the last one shaded (a run with a cavitation condition);
+* :func:`centreline_figure` (``femehl plot centreline RUN --t T``,
+  ``centreline_tT.png``): p and d along y = 0 at one stored time, the cavitated
+  interval(s) shaded: the nodes held at p = 0 (Reynolds) or clipped (half-Sommerfeld);
 * :func:`animation_file`: the maps and the centreline, one frame per stored time (GIF
   through matplotlib's Pillow writer), on request only (0.16 s a frame on the coarse
   mesh, more on finer ones).
@@ -28,7 +32,10 @@ import numpy as np
 
 __all__ = [
     "animation_file",
+    "cavitated_intervals",
+    "centreline_figure",
     "centreline_png",
+    "plot_centreline",
     "history_figure",
     "history_png",
     "maps_figure",
@@ -79,10 +86,52 @@ def profile_times(result, wanted=(0.5, 0.8, 1.0, 1.5, 2.0, 5.0)):
     return out
 
 
+#: shading of the cavitated interval(s) on the centreline
+_CAV_SHADE = {"color": "0.8", "alpha": 0.6, "lw": 0, "zorder": 0}
+
+
+def _cavitation_label(clipped: bool) -> str:
+    return "cavitated (p < 0 clipped)" if clipped else "cavitated (p held at 0)"
+
+
+def cavitation_label(snap) -> str:
+    """The legend entry of the cavitated region of a Snapshot."""
+    return _cavitation_label(snap.clipped)
+
+
+def cavitated_intervals(x, flag) -> list[tuple[float, float]]:
+    """The intervals ``(a, b)`` of sorted samples ``x`` where ``flag > 0.5`` (NaN: outside),
+    their ends halfway between the last sample in and the first out."""
+    x = np.asarray(x, dtype=float)
+    on = np.nan_to_num(np.asarray(flag, dtype=float), nan=0.0) > 0.5
+    if not on.any():
+        return []
+    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
+    starts = [0, *(edges[~on[edges]] + 1)] if on[0] else list(edges[~on[edges]] + 1)
+    ends = [*(edges[on[edges]]), x.size - 1] if on[-1] else list(edges[on[edges]])
+    mid = 0.5 * (x[:-1] + x[1:])
+    return [
+        (float(x[0] if a == 0 else mid[a - 1]), float(x[-1] if b == x.size - 1 else mid[b]))
+        for a, b in zip(starts, ends, strict=True)
+    ]
+
+
+def _shade_cavitated(axes, snap, x, cav):
+    """Shade the intervals of ``cav`` (centreline samples of ``snap.cavitated``) on ``axes``;
+    the first axis gets the legend entry.  Returns the intervals."""
+    spans = cavitated_intervals(x, cav)
+    for k, (a, b) in enumerate(spans):
+        for j, ax in enumerate(axes):
+            ax.axvspan(a, b, label=cavitation_label(snap) if k == 0 and j == 0 else None, **_CAV_SHADE)
+    return spans
+
+
 def centreline_png(results, path, times=None, labels=None, L=None):
     """Pressure and film thickness along y = 0 (x from -L to L) at several times.
 
-    ``results`` is one Result or a list of them (e.g. FE and FD on one plot).
+    ``results`` is one Result or a list of them (e.g. FE and FD on one plot).  With a
+    cavitation condition the cavitated interval(s) of the first result at the last time
+    are shaded.
     """
     plt = _plt()
     if not isinstance(results, (list, tuple)):
@@ -100,6 +149,18 @@ def centreline_png(results, path, times=None, labels=None, L=None):
             kw = {"color": colors[i % len(colors)], "ls": styles[k % len(styles)]}
             ax1.plot(x, res.pressure_at(pts, t), label=f"{lab} t={t:g}", **kw)
             ax2.plot(x, res.film_at(pts, t), **kw)
+    first = results[0]
+    if getattr(first.scene, "cavitation", None) is not None and first.states:
+        from .snapshot import snapshot
+
+        snap = snapshot(first.disc, first.state_at(times[-1]))
+        if snap.cavitated is not None:
+            xs, _, _, cav = _centreline(snap)
+            spans = cavitated_intervals(xs, cav)
+            for k, (a, b) in enumerate(spans):
+                for ax in (ax1, ax2):
+                    lab = f"{cavitation_label(snap)}, t={snap.t:g}" if k == 0 and ax is ax1 else None
+                    ax.axvspan(a, b, label=lab, **_CAV_SHADE)
     xh = np.linspace(-1, 1, 201)
     ax1.plot(xh, 2 / np.pi**2 * np.sqrt(1 - xh**2), color="k", lw=0.8, alpha=0.5, label="Hertz")
     ax1.set_ylabel("pressure p")
@@ -314,7 +375,8 @@ def maps_figure(snap, title: str = ""):
         ax_p.tricontourf(tri, snap.cavitated, levels=[0.5, 1.5], colors="none", hatches=["////"])
         import matplotlib.patches as mpatches
 
-        ax_p.add_patch(mpatches.Rectangle((0, 0), 0, 0, fill=False, hatch="////", label="cavitated (p = 0)"))
+        label = "cavitated (p < 0 clipped)" if snap.clipped else "cavitated (p = 0)"
+        ax_p.add_patch(mpatches.Rectangle((0, 0), 0, 0, fill=False, hatch="////", label=label))
     x0, y0 = snap.film_min_at
     xs, ys = ([x0, x0], [y0, -y0]) if snap.mirrored and abs(y0) > 0 else ([x0], [y0])
     for ax in (ax_d, ax_p):
@@ -341,7 +403,8 @@ def maps_png(snap, path, title: str = ""):
 
 
 def _centreline(snap, n=401):
-    """x, p(x, 0), d(x, 0) of a Snapshot (linear interpolation; film per triangle)."""
+    """x, p(x, 0), d(x, 0) and the cavitated flag (linear; None without a cavitation
+    condition) of a Snapshot (linear interpolation; film per triangle)."""
     import matplotlib.tri as mtri
 
     tri = mtri.Triangulation(snap.points[:, 0], snap.points[:, 1], snap.triangles)
@@ -353,7 +416,50 @@ def _centreline(snap, n=401):
     else:
         k = tri.get_trifinder()(x, y)
         d = np.where(k >= 0, snap.film[np.maximum(k, 0)], np.nan)
-    return x, p, d
+    cav = None
+    if snap.cavitated is not None:
+        cav = mtri.LinearTriInterpolator(tri, snap.cavitated)(x, y).filled(np.nan)
+    return x, p, d, cav
+
+
+def centreline_figure(snap, title: str = ""):
+    """Pressure and film along y = 0 at the Snapshot's time (a Figure), the cavitated
+    interval(s) shaded with a legend entry (a run with a cavitation condition)."""
+    plt = _plt()
+    x, p, d, cav = _centreline(snap)
+    fig, (ax_p, ax_d) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
+    if cav is not None:
+        _shade_cavitated((ax_p, ax_d), snap, x, cav)
+    ax_p.plot(x, p, color="C0", label="pressure p")
+    ax_p.axhline(0.0, color="k", lw=0.6)
+    ax_d.plot(x, d, color="C1", label="film d")
+    if np.all(d[np.isfinite(d)] > 0):
+        ax_d.set_yscale("log")
+    ax_p.set_ylabel("pressure p")
+    ax_d.set_ylabel("film thickness d")
+    ax_d.set_xlabel("x (sliding toward +x; exit at x < 0)")
+    ax_p.set_title(f"centreline y = 0 at t = {snap.t:g}", fontsize=10)
+    for ax in (ax_p, ax_d):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def centreline_name(t: float) -> str:
+    """The file name of the one-time centreline at a stored time."""
+    return f"centreline_t{t:g}.png"
+
+
+def plot_centreline(folder, t=None, out=None):
+    """``centreline_tT.png`` of a run folder: p and d along y = 0 at the stored time
+    nearest ``t`` (default: the last), the cavitated interval(s) shaded."""
+    from .snapshot import read_snapshot
+
+    snap = read_snapshot(folder, t)
+    path = out or pathlib.Path(folder) / centreline_name(snap.t)
+    return _save(_plt(), centreline_figure(snap, title=_title_of(folder)), path, dpi=100)
 
 
 def animation_file(snaps, path, fps: int = 8, title: str = ""):
@@ -397,7 +503,7 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
                 ax.set_ylim(-W, W)
                 ax.set_aspect("equal")
                 ax.set_title(f"{name}, t = {s.t:.3g}", fontsize=9)
-            x, p, d = _centreline(s)
+            x, p, d, _ = _centreline(s)
             ax_c.plot(x, p, color="C0", label="p")
             ax_c.plot(x, d, color="C1", label="d")
             ax_c.set_xlim(-W, W)
@@ -412,7 +518,15 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
 
 
 def line_png(result, path):
-    """p(x) and d(x) at a few stored times of a line-contact run."""
+    """p(x) and d(x) at a few stored times of a line-contact run (:func:`line_figure`)."""
+    return _save(_plt(), line_figure(result), path, 110)
+
+
+def line_figure(result):
+    """p(x) and d(x) at a few stored times of a line-contact run, the cavitated interval(s)
+    of the last one shaded (a run with a cavitation condition)."""
+    from .series import cavitated_nodes
+
     plt = _plt()
     states = list(result.states[:: max(1, len(result.states) // 6)])
     if states[-1] is not result.final:
@@ -427,9 +541,20 @@ def line_png(result, path):
     ax2.set_ylabel("d")
     ax2.set_xlabel("x  (cylinder slides toward +x)")
     ax1.legend(fontsize=7, ncol=2)
+    cav = cavitated_nodes(result.disc, result.final)
+    if cav is not None:
+        spans = cavitated_intervals(result.disc.x, cav)
+        from ..cavitation import clips_pressure
+
+        label = _cavitation_label(clips_pressure(result.scene))
+        for k, (a, b) in enumerate(spans):
+            for ax in (ax1, ax2):
+                lab = f"{label}, t = {result.final.t:.3g}" if k == 0 and ax is ax1 else None
+                ax.axvspan(a, b, label=lab, **_CAV_SHADE)
+    ax1.legend(fontsize=7, ncol=2)
     sc = result.scene
     fig.suptitle(f"cylinder on Winkler foundation: k = {sc.k:g}, beta = {sc.beta:g}")
-    return _save(plt, fig, path, 110)
+    return fig
 
 
 def _history(result, path):
@@ -524,4 +649,11 @@ def plot_animation(folder, out=None, fps: int = 8):
 
 
 #: ``femehl plot WHAT FOLDER``: the drawers of a run folder's pictures
-FOLDER_PLOTS = {"history": plot_history, "maps": plot_maps, "animation": plot_animation}
+FOLDER_PLOTS = {
+    "history": plot_history,
+    "maps": plot_maps,
+    "centreline": plot_centreline,
+    "animation": plot_animation,
+}
+#: the pictures of one stored time (``femehl plot ... --t``)
+TIMED_PLOTS = ("maps", "centreline")

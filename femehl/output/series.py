@@ -2,8 +2,10 @@
 
 Written as the run goes: every stored state adds its .vtu and rewrites the
 small .pvd index (atomically), so an interrupted run leaves a readable
-series.  Pressure is point data (with ``cavitated``, 1 where the pressure is held at 0,
-for a run with a cavitation condition); film thickness ``d``, deflection ``w`` and
+series.  Pressure is point data (with ``cavitated``, 1 where the pressure is held at 0
+or, half-Sommerfeld, was clipped, for a run with a cavitation condition; a half-Sommerfeld
+run's files carry the field data ``HalfSommerfeldClipped = 1`` and, as an XML comment, how
+to read them: :attr:`femehl.cavitation.HalfSommerfeld.note`); film thickness ``d``, deflection ``w`` and
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
 normalized; z = 0.  A half-disk run (computed on y >= 0) is written as the
@@ -66,6 +68,9 @@ class SeriesWriter:
         self._source = None
         if self.mirrored:
             self.points, self.cells, self._source = mirror_half(self.points, self.cells)
+        from ..cavitation import cavitation_model
+
+        self.cavitation = cavitation_model(getattr(getattr(disc, "scene", None), "cavitation", None))
         self.entries: list[tuple[float, str]] = []
         self.next_index = 0  # number of the next file (never one present)
 
@@ -99,7 +104,12 @@ class SeriesWriter:
         path = self.folder / name
         tmp = path.with_name(path.name + ".tmp")
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
-        _add_field_data(tmp, {"TimeValue": float(state.t), "MirroredHalfDisk": int(self.mirrored)})
+        fields = {"TimeValue": float(state.t), "MirroredHalfDisk": int(self.mirrored)}
+        note = None
+        if self.cavitation is not None:
+            fields.update(self.cavitation.field_data)
+            note = self.cavitation.note
+        _add_field_data(tmp, fields, note)
         os.replace(tmp, path)
         self.next_index += 1
         self.entries.append((state.t, name))
@@ -126,16 +136,19 @@ _TIME_RE = re.compile(rb'Name="TimeValue"[^>]*>\s*([^<\s]+)\s*<')
 
 def cavitated_nodes(disc, state):
     """1.0 at the cavitated nodes of ``state`` (``y < 0``: held at p = 0 with a multiplier
-    that keeps them there, or negative and joining the set at the next step), 0.0
-    elsewhere; None for a full-Sommerfeld run (no complementarity variable)."""
+    that keeps them there, or negative and joining the set at the next step; half-Sommerfeld:
+    the nodes whose full-Sommerfeld pressure was clipped), 0.0 elsewhere; None for a
+    full-Sommerfeld run (no complementarity variable)."""
     y = getattr(state, "p_aux", None)
     if y is None:
         return None
     return disc.expand((np.asarray(y) < 0.0).astype(float))
 
 
-def _add_field_data(path: pathlib.Path, values: dict) -> None:
-    """Put scalar field data (``TimeValue`` ...) in a .vtu (meshio's writer leaves it out)."""
+def _add_field_data(path: pathlib.Path, values: dict, note: str | None = None) -> None:
+    """Put scalar field data (``TimeValue`` ...) in a .vtu (meshio's writer leaves it out),
+    and ``note`` as an XML comment before it (how to read the fields, e.g. half-Sommerfeld;
+    a String array would be unreadable to meshio)."""
     data = path.read_bytes()
     arrays = b"".join(
         (
@@ -144,7 +157,8 @@ def _add_field_data(path: pathlib.Path, values: dict) -> None:
         ).encode()
         for k, v in values.items()
     )
-    block = b"\n<FieldData>\n" + arrays + b"</FieldData>"
+    comment = b"" if not note else f"\n<!-- {note.replace('--', '-')} -->".encode()
+    block = comment + b"\n<FieldData>\n" + arrays + b"</FieldData>"
     i = data.find(_GRID_TAG)
     if i >= 0:
         i += len(_GRID_TAG)

@@ -76,6 +76,7 @@ class Snapshot:
     mirrored: bool
     L: float
     cavitated: np.ndarray | None = None  # (n,) 1 where p is held at 0 (a cavitation condition)
+    clipped: bool = False  # half-Sommerfeld: the cavitated nodes are those whose p < 0 was clipped
 
     @property
     def film_at_points(self) -> np.ndarray:
@@ -102,8 +103,9 @@ def _triangles(cells):
             owner += [at + np.arange(c.shape[0])] * 2
         else:
             raise OutputError(
-                f"maps need a 2-D mesh (triangles or quads), this run has {kind!r} cells: "
-                "a line-contact run has no maps; see its line.png and history.png."
+                f"maps and the centreline need a 2-D mesh (triangles or quads), this run has "
+                f"{kind!r} cells: a line-contact run has no maps; see its line.png (p and d "
+                "along x, the cavitated interval shaded) and history.png."
             )
         at += c.shape[0]
     return np.vstack(tris), np.concatenate(owner)
@@ -116,7 +118,18 @@ def _degenerate(tris, pts):
 
 
 def _build(
-    t, points, cells, pressure, film, on_points, mirrored, L, film_min=None, film_min_at=None, cav=None
+    t,
+    points,
+    cells,
+    pressure,
+    film,
+    on_points,
+    mirrored,
+    L,
+    film_min=None,
+    film_min_at=None,
+    cav=None,
+    clipped=False,
 ):
     tris, owner = _triangles(cells)
     pts = np.asarray(points, dtype=float)[:, :2]
@@ -140,6 +153,7 @@ def _build(
         bool(mirrored),
         float(L),
         None if cav is None else np.asarray(cav, dtype=float),
+        bool(clipped),
     )
 
 
@@ -159,7 +173,10 @@ def snapshot(disc, state) -> Snapshot:
         cells = full_cells
     L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
     fmin, at = state.film_min, tuple(state.film_min_at)
-    return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav)
+    from ..cavitation import clips_pressure
+
+    clipped = clips_pressure(getattr(disc, "scene", None))
+    return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav, clipped)
 
 
 # ---- reading a run folder ----------------------------------------------------------------
@@ -241,9 +258,11 @@ def read_snapshot(folder, t: float | None = None, summary: dict | None = None) -
         if abs(rows["t"][j] - ts[k]) <= 1e-9 * max(1.0, abs(ts[k])):
             fmin, where = rows["film_min"][j], (rows["film_min_x"][j], rows["film_min_y"][j])
     cav = mesh.point_data.get("cavitated")
-    return _build(
-        ts[k], mesh.points, cells, mesh.point_data["pressure"], film, on_points, mirrored, L, fmin, where, cav
-    )
+    from .series import field_value
+
+    clipped = bool(field_value(files[k][1], "HalfSommerfeldClipped") or 0)
+    p = mesh.point_data["pressure"]
+    return _build(ts[k], mesh.points, cells, p, film, on_points, mirrored, L, fmin, where, cav, clipped)
 
 
 def _mirrored(path) -> bool:

@@ -1,11 +1,16 @@
-"""The summary CSV: one row per step, written and flushed as the run goes."""
+"""The summary CSV: one row per step, written and flushed as the run goes.
+
+The columns are :data:`COLUMNS`; a run with a cavitation condition adds the condition's
+(:func:`columns_for`: ``cavitated_area`` and, for the Reynolds condition, ``full_film_source``,
+for half-Sommerfeld ``load_full``; see :mod:`femehl.cavitation`), read from ``state.info``.
+"""
 
 from __future__ import annotations
 
 import csv
 import pathlib
 
-__all__ = ["COLUMNS", "ERROR_COLUMNS", "SummaryWriter", "add_error_columns", "read_summary"]
+__all__ = ["COLUMNS", "ERROR_COLUMNS", "SummaryWriter", "add_error_columns", "columns_for", "read_summary"]
 
 COLUMNS = (
     "t",
@@ -22,7 +27,16 @@ COLUMNS = (
 )
 
 
-def _row(state):
+def columns_for(scene) -> tuple:
+    """The summary columns of a run of ``scene``: :data:`COLUMNS` and its cavitation
+    condition's (``scene.cavitation``; none for full Sommerfeld)."""
+    from ..cavitation import cavitation_columns
+
+    return COLUMNS + cavitation_columns(scene)
+
+
+def _row(state, extra=()):
+    info = state.info or {}
     return (
         state.t,
         state.hc,
@@ -35,6 +49,7 @@ def _row(state):
         state.p_max,
         state.p_max_at[0],
         state.p_max_at[1],
+        *(float(info.get(c, float("nan"))) for c in extra),
     )
 
 
@@ -42,21 +57,26 @@ class SummaryWriter:
     """Write one CSV row per State (normalized units) to ``path``, flushed at once; header first.
 
     ``append=True`` continues an existing file (the header is written only to a new or
-    empty one).
+    empty one).  ``columns``: :data:`COLUMNS` and any of a cavitation condition's
+    (:func:`columns_for`), these read from ``state.info``.
     """
 
-    def __init__(self, path, append: bool = False):
+    def __init__(self, path, append: bool = False, columns=COLUMNS):
+        self.columns = tuple(columns)
+        if self.columns[: len(COLUMNS)] != COLUMNS:
+            raise ValueError(f"summary columns must start with {COLUMNS}, got {self.columns}")
+        self._extra = self.columns[len(COLUMNS) :]
         self.path = pathlib.Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         new = not append or not self.path.is_file() or self.path.stat().st_size == 0
         self._fh = open(self.path, "a" if append else "w", newline="")  # noqa: SIM115 - kept open
         self._csv = csv.writer(self._fh)
         if new:
-            self._csv.writerow(COLUMNS)
+            self._csv.writerow(self.columns)
         self._fh.flush()
 
     def write(self, state):
-        self._csv.writerow([f"{v:.10g}" for v in _row(state)])
+        self._csv.writerow([f"{v:.10g}" for v in _row(state, self._extra)])
         self._fh.flush()
 
     def close(self):
@@ -73,13 +93,14 @@ class SummaryWriter:
 def write_summary(result, path):
     """Write a finished Result's per-step table (same columns) to ``path``."""
     s = result.summary()
+    columns = COLUMNS + tuple(c for c in s if c not in COLUMNS)
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(COLUMNS)
+        w.writerow(columns)
         for i in range(len(s["t"])):
-            w.writerow([f"{s[c][i]:.10g}" for c in COLUMNS])
+            w.writerow([f"{s[c][i]:.10g}" for c in columns])
     return path
 
 

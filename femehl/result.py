@@ -55,9 +55,11 @@ class Result:
 
     def __post_init__(self):
         from .cavitation import cavitation_columns
+        from .output.table import extra_columns
 
         self._cavitation_columns = cavitation_columns(self.scene)
-        for k in self._cavitation_columns:
+        self._extra_columns = extra_columns(self.scene)
+        for k in self._extra_columns:
             self._rows.setdefault(k, [])
 
     @property
@@ -67,11 +69,18 @@ class Result:
         (half-Sommerfeld), see :mod:`femehl.cavitation`."""
         return self._cavitation_columns
 
+    @property
+    def extra_columns(self) -> tuple:
+        """Every per-step figure beyond the standard ones, as in ``summary.csv``: the
+        cavitation condition's and the substrate's (a viscoelastic solid's ``friction``,
+        ``dissipation_film``, ``power_sliding``, :mod:`femehl.tribology`)."""
+        return self._extra_columns
+
     def record(self, state: State, store_fields: bool = True) -> None:
         """Append one state's scalars (and its fields when ``store_fields``)."""
         for k in _SCALARS:
             self._rows[k].append(float(getattr(state, k)))
-        for k in self.cavitation_columns:  # NaN where a state does not carry it
+        for k in self.extra_columns:  # NaN where a state does not carry it
             self._rows[k].append(float((state.info or {}).get(k, np.nan)))
         self._rows["film_min_at"].append(tuple(state.film_min_at))
         self._rows["p_max_at"].append(tuple(state.p_max_at))
@@ -200,7 +209,7 @@ class Result:
         at = np.asarray(self._rows["film_min_at"], dtype=float).reshape(-1, 2)
         pa = np.asarray(self._rows["p_max_at"], dtype=float).reshape(-1, 2)
         out.update(film_min_x=at[:, 0], film_min_y=at[:, 1], p_max_x=pa[:, 0], p_max_y=pa[:, 1])
-        out.update({k: getattr(self, k) for k in self.cavitation_columns})
+        out.update({k: getattr(self, k) for k in self.extra_columns})
         return out
 
     def impact(self) -> dict:
@@ -232,7 +241,7 @@ class Result:
 
     def value_at(self, name: str, t: float) -> float:
         """A per-step scalar (e.g. "load") at time ``t``, linear in time between steps."""
-        names = list(_SCALARS) + list(self.cavitation_columns)
+        names = list(_SCALARS) + list(self.extra_columns)
         if name not in names:
             raise SceneError(f"unknown quantity {name!r}: value_at takes one of {names}.")
         ts = self.t

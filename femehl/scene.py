@@ -809,8 +809,20 @@ class Dimensional:
         """Volume per unit time = length^2 height / time [m^3/s] (a film flux integral)."""
         return self.length**2 * self.height / self.time
 
+    @property
+    def tangential_force(self) -> float:
+        """Friction-force scale = pressure * height * length [N] (femehl.tribology)."""
+        return self.pressure * self.height * self.length
+
+    @property
+    def power(self) -> float:
+        """Power scale = tangential force * V_ss [W] (femehl.tribology)."""
+        return self.tangential_force * self.V_ss
+
     #: the quantities :meth:`to_si` converts
     QUANTITIES: ClassVar[tuple] = (
+        "tangential_force",
+        "power",
         "length",
         "height",
         "time",
@@ -852,6 +864,10 @@ class Dimensional:
         "load_full": ("load_full", "force", "N"),
         "cavitated_area": ("cavitated_area", "area", "m2"),
         "full_film_source": ("full_film_source", "volume_rate", "m3/s"),
+        # a viscoelastic substrate's sliding energy budget (femehl.tribology)
+        "friction": ("friction", "tangential_force", "N"),
+        "dissipation_film": ("dissipation_film", "power", "W"),
+        "power_sliding": ("power_sliding", "power", "W"),
     }
 
     def result_table(self, result) -> dict:

@@ -40,7 +40,10 @@ import numpy as np
 
 from .errors import SceneError
 
-__all__ = ["sliding_energetics"]
+__all__ = ["ENERGETICS_COLUMNS", "sliding_energetics"]
+
+#: the per-step figures a run reports when its substrate asks for them (summary.csv)
+ENERGETICS_COLUMNS = ("friction", "dissipation_film", "power_sliding")
 
 
 def sliding_energetics(disc, state, beta: float) -> dict:

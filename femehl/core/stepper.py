@@ -350,6 +350,11 @@ class LaggedStepper:
         if mem is not None:
             u = Cp if Cp is not None else np.asarray(self.C @ p).ravel()
             extra.update(creep=mem.creep(u), creep_prev=state.creep)
+            if hasattr(self.disc, "pressure_gradient"):  # the sliding energy budget, per step
+                from ..tribology import sliding_energetics
+
+                e = sliding_energetics(self.disc, new, self.beta)
+                new.info.update({k: e[k] for k in getattr(self.scene.substrate, "columns", ())})
         if hc_dot is not None:
             extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
         if extra:

@@ -30,9 +30,19 @@ COLUMNS = (
 def columns_for(scene) -> tuple:
     """The summary columns of a run of ``scene``: :data:`COLUMNS` and its cavitation
     condition's (``scene.cavitation``; none for full Sommerfeld)."""
+
+    return COLUMNS + extra_columns(scene)
+
+
+def extra_columns(scene) -> tuple:
+    """The per-step figures beyond :data:`COLUMNS` a run of ``scene`` reports: its cavitation
+    condition's, then its substrate's (``substrate.columns``, e.g. a viscoelastic solid's
+    sliding energy budget, :mod:`femehl.tribology`); read from ``state.info``."""
     from ..cavitation import cavitation_columns
 
-    return COLUMNS + cavitation_columns(scene)
+    if scene is None:
+        return ()
+    return cavitation_columns(scene) + tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
 
 
 def _row(state, extra=()):

@@ -105,6 +105,8 @@ class Viscoelastic:
     G_inf: float = 1.0
     elastic: object = field(default_factory=HalfSpace)
     kind = "viscoelastic"
+    #: per-step figures of its runs (summary.csv, Result): the sliding energy budget
+    columns = ("friction", "dissipation_film", "power_sliding")
 
     def __post_init__(self):
         G0 = check_positive("unrelaxed modulus G0", self.G0, "Give G0 in units of G.")

@@ -277,8 +277,23 @@ def _si_scene(raw, path):
     if not isinstance(si, dict):
         raise SceneFileError(f"{path}: [si] must be a table.")
     si = dict(si)
-    keys = {"R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L", "load", "alpha", "roelands_Z"}
-    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z"}
+    visco = {"G0", "tau", "G_inf"}  # a standard linear solid: unrelaxed modulus, relaxation time
+    keys = {
+        "R",
+        "G",
+        "eta",
+        "V_ss",
+        "h_inf",
+        "nu",
+        "h0",
+        "t1",
+        "T",
+        "L",
+        "load",
+        "alpha",
+        "roelands_Z",
+    } | visco
+    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z"} | visco
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
     if extra or missing:
@@ -315,6 +330,17 @@ def _si_scene(raw, path):
             else:
                 model = Barus.from_si(si["alpha"], dim)
             changes["fluid"] = dataclasses.replace(scene.fluid, viscosity=model)
+        if visco & set(si):
+            if not {"G0", "tau"} <= set(si):
+                raise SceneFileError(
+                    f"{path}: [si] a viscoelastic substrate needs G0 [Pa] (unrelaxed modulus) and "
+                    "tau [s] (relaxation time); G_inf [Pa] is optional (default: G)."
+                )
+            from .substrates import Viscoelastic
+
+            changes["substrate"] = Viscoelastic.from_si(
+                si["G0"], si["tau"], dim, G_inf=si.get("G_inf"), elastic=scene.substrate
+            )
         if changes:
             scene = dataclasses.replace(scene, **changes)
     except SceneFileError:

@@ -94,7 +94,20 @@ def check_paper_figures(mod, tmp_path):
     assert (tmp_path / "fig5.png").exists() and (tmp_path / "fig6.png").exists()
 
 
+def check_rubber_slider(mod, tmp_path):
+    """Three speeds (shortened to t = 6, V = 1 - 1e-4): the rubber's hysteresis is largest at
+    De ~ 1, the middle speed (elastic in both limits), and the two dissipations add up to
+    the friction work (steady sliding, femehl.tribology) to 1e-3."""
+    rows = mod.main(out=tmp_path, speeds=(1e-3, 1e-2, 1e-1), t_end=6.0, dt=0.05)
+    rubber = [r["mu_rubber"] for r in rows]
+    assert rubber[1] > max(rubber[0], rubber[2]) and min(rubber) > 0  # the peak near De = 1
+    for r in rows:
+        assert r["mu_rubber"] + r["mu_film"] == pytest.approx(r["mu"], rel=1e-3)
+    assert (tmp_path / "friction_speed.png").exists() and (tmp_path / "V_1e-02" / "summary.csv").exists()
+
+
 CHECKS = {
+    "rubber_slider": check_rubber_slider,
     "load_controlled": check_load_controlled,
     "ellipsoid_sliding": check_ellipsoid_sliding,
     "custom_shape": check_custom_shape,

@@ -130,6 +130,16 @@ class Viscoelastic:
         object.__setattr__(self, "G_inf", Gi)
         object.__setattr__(self, "tau", tau)
 
+    @classmethod
+    def from_si(cls, G0, tau, dim, G_inf=None, elastic=None) -> Viscoelastic:
+        """From SI values: ``G0`` and ``G_inf`` [Pa] (default ``G_inf = dim.G``, the modulus
+        in beta), ``tau`` [s]; ``dim`` a :class:`femehl.Dimensional` (its time scale)."""
+        G = float(dim.G)
+        G0 = check_positive("[si] G0 [Pa]", G0, "Give the unrelaxed shear modulus in Pa.")
+        tau = check_positive("[si] tau [s]", tau, "Give the relaxation time in seconds.")
+        Gi = G if G_inf is None else check_positive("[si] G_inf [Pa]", G_inf, "Give it in Pa.")
+        return cls(G0=G0 / G, tau=tau / dim.time, G_inf=Gi / G, elastic=elastic or HalfSpace(dim.nu))
+
     # ---- the creep function ---------------------------------------------------------------
     @property
     def J0(self) -> float:

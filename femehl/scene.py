@@ -819,10 +819,28 @@ class Dimensional:
         """Power scale = tangential force * V_ss [W] (femehl.tribology)."""
         return self.tangential_force * self.V_ss
 
+    @property
+    def energy(self) -> float:
+        """Energy scale = force * height [J] (a free indenter's budget, femehl.tribology)."""
+        return self.force * self.height
+
+    @property
+    def mass(self) -> float:
+        """Mass scale of a free indenter = force * time^2 / height [kg] (Motion(mass=...))."""
+        return self.force * self.time**2 / self.height
+
+    @property
+    def approach_speed(self) -> float:
+        """Speed scale of the tip clearance, dhc/dt = height / time [m/s] (Motion(hc_dot0=...))."""
+        return self.height / self.time
+
     #: the quantities :meth:`to_si` converts
     QUANTITIES: ClassVar[tuple] = (
         "tangential_force",
         "power",
+        "energy",
+        "mass",
+        "approach_speed",
         "length",
         "height",
         "time",
@@ -868,6 +886,7 @@ class Dimensional:
         "friction": ("friction", "tangential_force", "N"),
         "dissipation_film": ("dissipation_film", "power", "W"),
         "power_sliding": ("power_sliding", "power", "W"),
+        "elastic_energy": ("elastic_energy", "energy", "J"),
     }
 
     def result_table(self, result) -> dict:

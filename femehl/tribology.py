@@ -30,6 +30,14 @@ viscoelastic dissipation in the substrate (zero for an elastic one, whose operat
 symmetric), and the balance reads ``f V = D_film + P_sliding``.  In a transient it
 omits ``-(1/2) int p dW/dt``, the rate of change of the stored elastic energy.
 
+A free indenter (``m hc'' = load - force`` in femehl's units) has the collision budget
+
+    (1/2) m hc'^2 + force hc + E_el + int 2 D_film dt = const,   E_el = (1/2) int p (-W) dA,
+
+the factor 2 because the powers above are in units of ``f0 V_ss``, twice the unit
+``load h_inf / time`` of Newton's law (with the film's Reynolds equation this is an
+identity of the continuous problem, so the discrete budget measures the time error).
+
 On a half disk every integrand is even in y and the integrals are doubled.  The same
 formulas hold per unit length for line contact in its normalized units.
 """
@@ -40,10 +48,22 @@ import numpy as np
 
 from .errors import SceneError
 
-__all__ = ["ENERGETICS_COLUMNS", "sliding_energetics"]
+__all__ = ["ENERGETICS_COLUMNS", "FREE_COLUMNS", "TRIBOLOGY_COLUMNS", "sliding_energetics"]
 
-#: the per-step figures a run reports when its substrate asks for them (summary.csv)
+#: the per-step figures a run on a viscoelastic substrate reports (summary.csv)
 ENERGETICS_COLUMNS = ("friction", "dissipation_film", "power_sliding")
+#: ... and a run of a free indenter (its collision's energy budget)
+FREE_COLUMNS = ("dissipation_film", "elastic_energy")
+#: every figure :func:`sliding_energetics` computes
+TRIBOLOGY_COLUMNS = (
+    "friction",
+    "shear_couette",
+    "shear_poiseuille",
+    "pressure_drag",
+    "dissipation_film",
+    "power_sliding",
+    "elastic_energy",
+)
 
 
 def sliding_energetics(disc, state, beta: float) -> dict:
@@ -62,8 +82,8 @@ def sliding_energetics(disc, state, beta: float) -> dict:
     -------
     dict
         ``friction`` (= ``shear_couette + shear_poiseuille + pressure_drag``), its three
-        parts, ``dissipation_film`` and ``power_sliding``, normalized as in the module
-        docstring.
+        parts, ``dissipation_film``, ``power_sliding`` and ``elastic_energy``, normalized as
+        in the module docstring.
     """
     grad = getattr(disc, "pressure_gradient", None)
     if grad is None:
@@ -86,6 +106,7 @@ def sliding_energetics(disc, state, beta: float) -> dict:
         "pressure_drag": float(-(a @ ((W + d) * gx))),
         "dissipation_film": float(a @ (V * V / (6.0 * beta * d) + 0.5 * beta * d**3 * g2)),
         "power_sliding": float(-V * (a @ (W * gx))),
+        "elastic_energy": float(0.5 * (a @ (np.asarray(disc.average() @ p).ravel() * -W))),
     }
     out["friction"] = out["shear_couette"] + out["shear_poiseuille"] + out["pressure_drag"]
     return out

@@ -161,3 +161,24 @@ def test_toml(tmp_path):
     f.write_text(src.replace("[motion.gap]", "[motion]\nmass = -0.5\n\n[motion.gap]"))
     with pytest.raises(SceneError, match="mass"):
         load_scene_file(f)
+
+
+def test_collision_energy_budget_closes_to_the_time_error():
+    """Kinetic + elastic energy + twice the film's dissipated work (femehl.tribology's unit)
+    stay at the thrown sphere's kinetic energy: the budget is an identity of the continuous
+    problem, so its drift is BDF2's time error (measured 6.4 % and 1.7 % of the initial energy
+    at dt = 0.02 and 0.01, ratio 3.9: second order)."""
+    drift = []
+    for dt in (0.02, 0.01):
+        sc = Scene(
+            fluid=Fluid(1000.0),
+            motion=Motion(gap=Constant(0.5), velocity=0.0, mass=0.05, hc_dot0=-1.0),
+            domain=Domain(3.0),
+        )
+        r = femehl.solve(sc, t_end=3.0, dt=dt, mesh="coarse", estimate=False, scheme="bdf2", store_every=0)
+        D = r.dissipation_film
+        work = np.concatenate([[0.0], np.cumsum(np.diff(r.t) * (D[1:] + D[:-1]))])  # 2 x trapezoid
+        total = 0.5 * 0.05 * r.hc_dot**2 + r.elastic_energy + work
+        assert total[0] == pytest.approx(0.5 * 0.05 * 1.0)
+        drift.append(np.max(np.abs(total / total[0] - 1.0)))
+    assert drift[1] < 0.025 and 3.0 < drift[0] / drift[1] < 5.0

@@ -122,6 +122,13 @@ class LaggedStepper:
             self.cavitation.check_scene(scene)
         memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
         self.memory = None if memory is None else memory(disc)
+        from ..output.table import extra_columns
+        from ..tribology import TRIBOLOGY_COLUMNS
+
+        # the energy budget's figures the scene reports (femehl.tribology), where the method has them
+        self._tribology = [c for c in extra_columns(scene) if c in TRIBOLOGY_COLUMNS]
+        if not hasattr(disc, "pressure_gradient"):
+            self._tribology = []
         self._FC: dict[str, object] = {}
         self._rows_cache: dict[int, np.ndarray] = {}
         self.info = dict(disc.info)
@@ -279,7 +286,16 @@ class LaggedStepper:
         state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
         if self.memory is not None:  # the material at rest, unloaded
             state = dataclasses.replace(state, creep=np.zeros(self.memory.size))
+        self._budget(state)
         return state
+
+    def _budget(self, state):
+        """The energy budget's figures the scene reports (femehl.tribology), into ``state.info``."""
+        if self._tribology:
+            from ..tribology import sliding_energetics
+
+            e = sliding_energetics(self.disc, state, self.beta)
+            state.info.update({k: e[k] for k in self._tribology})
 
     # ---- one step -----------------------------------------------------------------------
     def step(self, state: State, t_new: float, dt: float) -> State:
@@ -350,11 +366,7 @@ class LaggedStepper:
         if mem is not None:
             u = Cp if Cp is not None else np.asarray(self.C @ p).ravel()
             extra.update(creep=mem.creep(u), creep_prev=state.creep)
-            if hasattr(self.disc, "pressure_gradient"):  # the sliding energy budget, per step
-                from ..tribology import sliding_energetics
-
-                e = sliding_energetics(self.disc, new, self.beta)
-                new.info.update({k: e[k] for k in getattr(self.scene.substrate, "columns", ())})
+        self._budget(new)
         if hc_dot is not None:
             extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
         if extra:

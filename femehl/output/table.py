@@ -39,10 +39,14 @@ def extra_columns(scene) -> tuple:
     condition's, then its substrate's (``substrate.columns``, e.g. a viscoelastic solid's
     sliding energy budget, :mod:`femehl.tribology`); read from ``state.info``."""
     from ..cavitation import cavitation_columns
+    from ..tribology import FREE_COLUMNS
 
     if scene is None:
         return ()
-    return cavitation_columns(scene) + tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
+    cols = cavitation_columns(scene) + tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
+    if getattr(getattr(scene, "motion", None), "free", False):  # a free indenter's energy budget
+        cols += FREE_COLUMNS
+    return tuple(dict.fromkeys(cols))
 
 
 def _row(state, extra=()):

@@ -57,6 +57,7 @@ alone.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -110,6 +111,10 @@ class LineScene(SceneEffects):
         Pressure-dependent viscosity (:mod:`femehl.viscosity`); None: isoviscous.
     cavitation : {None, "reynolds", "half-sommerfeld"}, optional
         Cavitation condition (:mod:`femehl.cavitation`); None: full Sommerfeld.
+    viscoelastic : femehl.Viscoelastic, optional
+        A viscoelastic foundation: the standard linear solid whose relaxed stiffness is
+        ``k * G_inf`` and unrelaxed ``k * G0`` (its ``elastic`` is the Winkler(k) of this
+        scene; :mod:`femehl.substrates.viscoelastic`); None: elastic.
     """
 
     default_method = "line"
@@ -121,6 +126,7 @@ class LineScene(SceneEffects):
     load: Callable[[float], float] | None = None
     viscosity: object = field(default=None, metadata={"describe": "omit_default"})
     cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
+    viscoelastic: object = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
         from .cavitation import check_cavitation
@@ -128,6 +134,13 @@ class LineScene(SceneEffects):
 
         check_viscosity(self.viscosity)
         check_cavitation(self.cavitation)
+        from .substrates import Viscoelastic
+
+        if self.viscoelastic is not None and not isinstance(self.viscoelastic, Viscoelastic):
+            raise SceneError(
+                f"LineScene(viscoelastic=...) must be a femehl.Viscoelastic(G0, tau), got "
+                f"{type(self.viscoelastic).__name__}."
+            )
         object.__setattr__(
             self,
             "k",
@@ -186,9 +199,11 @@ class LineScene(SceneEffects):
         return Fluid(self.beta)
 
     @property
-    def substrate(self) -> Winkler:
-        """The Winkler foundation ``w = -p/k``, as for a 2-D scene."""
-        return Winkler(self.k)
+    def substrate(self):
+        """The Winkler foundation ``w = -p/k`` (relaxing as ``viscoelastic`` says, if given)."""
+        if self.viscoelastic is None:
+            return Winkler(self.k)
+        return dataclasses.replace(self.viscoelastic, elastic=Winkler(self.k))
 
     @property
     def imposed_load(self) -> bool:

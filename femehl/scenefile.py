@@ -434,6 +434,15 @@ def _line_scene(raw, path):
                 "Rescale the other parameters instead."
             )
     sub = raw.get("substrate")
+    visco = None
+    if isinstance(sub, dict) and sub.get("kind") == "viscoelastic":  # relaxing its Winkler foundation
+        visco = _build(SUBSTRATES, sub, "substrate", path)
+        if type(visco.elastic).__name__ != "Winkler":
+            raise SceneFileError(
+                f"{path}: [substrate] kind = 'viscoelastic' for line contact relaxes a Winkler "
+                'foundation: give elastic = {kind = "winkler", k = ...}.'
+            )
+        sub = {"kind": "winkler", "k": visco.elastic.k}
     if not isinstance(sub, dict) or sub.get("kind") != "winkler":
         got = sub.get("kind") if isinstance(sub, dict) else sub
         raise SceneFileError(
@@ -447,7 +456,7 @@ def _line_scene(raw, path):
     domain = raw.get("domain", {})
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
-    kw = {"k": winkler.k, "motion": motion}
+    kw = {"k": winkler.k, "motion": motion, **({"viscoelastic": visco} if visco is not None else {})}
     kw.update({k: fluid[k] for k in ("beta", "viscosity", "cavitation") if k in fluid})
     if "L" in domain:
         kw["L"] = domain["L"]

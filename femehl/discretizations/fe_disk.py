@@ -25,7 +25,15 @@ from skfem import Basis, ElementTriP0, ElementTriP1
 from ..errors import SceneError
 from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
-from ..kernels import edge_terms, mesh_edges, triangle_influence
+from ..kernels import (
+    edge_terms,
+    mesh_edges,
+    radial_influence,
+    smooth_lowrank,
+    smooth_matrix,
+    sparse_radial_influence,
+    triangle_influence,
+)
 from ..validation import check_operator_tol
 from . import register_method
 from ._p1p0 import P1P0
@@ -150,8 +158,22 @@ class FEDisc(P1P0):
         """The operator to build, checked against the machine's memory."""
         from ..fe.mesh import check_mesh_memory, dense_fits
 
+        sub = self.scene.substrate
+        allowed = getattr(sub, "operators", OPERATORS)
+        if operator == "fast" and "fast" not in allowed:
+            raise SceneError(
+                f"the fast hierarchical operator approximates the half space's 1/r kernel only; "
+                f"a {type(sub).__name__} substrate needs operator='dense' (or 'auto')."
+            )
         if operator == "auto":
-            operator = "fast" if ne >= FAST_CROSSOVER or not dense_fits(ne, self.n) else "dense"
+            big = ne >= FAST_CROSSOVER or not dense_fits(ne, self.n)
+            operator = "fast" if big and "fast" in allowed else "dense"
+            if big and "fast" not in allowed and not dense_fits(ne, self.n):
+                raise SceneError(
+                    f"mesh {self.dm.name}: {ne} elements need a dense elastic operator that does not "
+                    f"fit in this machine's memory, and a {type(sub).__name__} substrate has no fast "
+                    "operator: use a coarser mesh (a ladder name or larger mesh sizes)."
+                )
         check_mesh_memory(ne, self.n, self.dm.name, operator=operator)
         return operator
 
@@ -212,6 +234,9 @@ class FEDisc(P1P0):
             from ..hmatrix import FastCompliance
 
             return FastCompliance(self, tol=self.operator_tol)
+        return self._dense_boussinesq()
+
+    def _dense_boussinesq(self):
         ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
         SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse
@@ -225,6 +250,42 @@ class FEDisc(P1P0):
                 T -= edge_terms(self.centroids[e], mirror, edges)
             C[e] = (SP.T @ T.T).T
         return C
+
+    def radial_kernel(self, kernel):
+        """``X_g P[:, free]``, ``X_g[i, e] = int_{T_e} g(|c_i - x'|) dA'``, mirror included.
+
+        ``g = kernel.singular / r - R(r)`` with R smooth (the radial-kernel protocol of
+        :func:`femehl.kernels.radial_triangle_pairs`, e.g. an elastic layer's
+        :class:`femehl.layer_kernel.LayerKernel`).  Sparse (CSR) when the kernel's cut-off
+        leaves few pairs (a thin layer), else dense: the exact ``1/r`` part as in
+        :meth:`boussinesq` minus the smooth part, by a low-rank Chebyshev interpolation
+        where R is smooth over the whole disk (:func:`femehl.kernels.smooth_lowrank`, a
+        thick layer), else directly (:func:`femehl.kernels.smooth_matrix`).
+        """
+        X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half)
+        P = self.P[:, self.free]
+        if X is not None:
+            return (X @ P).tocsr()
+        C = self._dense_boussinesq()
+        if kernel.singular != 1.0:
+            C *= kernel.singular
+        low = smooth_lowrank(self.centroids, self.tri, kernel, mirror_y=self.half)
+        if low is not None:  # a thick layer: R smooth over the whole disk
+            S, K, Q = low
+            C -= S @ (K @ np.asarray((P.T @ Q.T).T))
+        else:
+            XR = smooth_matrix(self.centroids, self.tri, kernel, mirror_y=self.half)
+            C -= np.asarray(P.T @ XR.T).T
+        return C
+
+    def radial_kernel_rows(self, kernel, points):
+        """Rows of :meth:`radial_kernel` at arbitrary points (mirror image included)."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        X = radial_influence(pts, self.tri, kernel, mirror_y=self.half)
+        P = self.P[:, self.free]
+        if sp.issparse(X):
+            return (X @ P).tocsr()
+        return np.asarray(P.T @ X.T).T
 
     def boussinesq_rows(self, points):
         """Rows of :meth:`boussinesq` at arbitrary points (mirror image included)."""

@@ -42,6 +42,7 @@ __all__ = [
     "smooth_pairs",
     "singular_pairs",
     "near_pairs",
+    "pair_fraction",
 ]
 
 _BLOCK_BYTES = 64 * 2**20  # temporaries per block of rows
@@ -274,7 +275,7 @@ _G7_W = np.array([0.225, *[0.132394152788506] * 3, *[0.125939180544827] * 3])
 #: a triangle whose diameter is at most this times the kernel's ``scale`` is integrated by
 #: the 7-point rule (error <= 4e-11 of area / scale, measured in
 #: tests/test_layer.py), a larger one by the polar edge integrals
-SMALL_TRIANGLE = 0.1
+SMALL_TRIANGLE = 0.25
 #: polar edge integrals: Gauss-Legendre points per piece, pieces at most this times ``scale``
 #: (<= 5e-13 of area / scale against 16 points on pieces of scale / 4, tests/test_layer.py)
 EDGE_GAUSS = 8
@@ -432,16 +433,23 @@ def near_pairs(points, tri, radius):
     cen = tri.mean(axis=1)
     reach = np.max(np.hypot(*(tri - cen[:, None, :]).transpose(2, 0, 1)), axis=1)
     big = float(reach.max()) if reach.size else 0.0
-    D = cKDTree(pts).sparse_distance_matrix(cKDTree(cen), radius + big, output_type="coo_matrix")
-    i, j, dist = D.row, D.col, D.data
-    keep = dist <= radius + reach[j]
-    # sparse_distance_matrix drops exact zero distances: add the coincident pairs back
-    hit = cKDTree(cen).query(pts, k=1, distance_upper_bound=1e-300)
-    same = np.flatnonzero(np.isfinite(hit[0]))
-    ii = np.r_[i[keep], same]
-    jj = np.r_[j[keep], hit[1][same]]
-    key = np.unique(ii.astype(np.int64) * tri.shape[0] + jj)
-    return key // tri.shape[0], key % tri.shape[0]
+    D = cKDTree(pts).sparse_distance_matrix(cKDTree(cen), radius + big, output_type="ndarray")
+    i, j = D["i"].astype(np.intp), D["j"].astype(np.intp)
+    keep = D["v"] <= radius + reach[j]  # (zero distances are kept: output_type ndarray)
+    return i[keep], j[keep]
+
+
+def pair_fraction(points, tri, radius, sample=256):
+    """Estimated fraction of the (point, triangle) pairs :func:`near_pairs` would return."""
+    from scipy.spatial import cKDTree
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    tri = np.asarray(tri, dtype=float).reshape(-1, 3, 2)
+    cen = tri.mean(axis=1)
+    reach = float(np.max(np.hypot(*(tri - cen[:, None, :]).transpose(2, 0, 1)))) if tri.size else 0.0
+    sel = np.random.default_rng(0).choice(pts.shape[0], min(sample, pts.shape[0]), replace=False)
+    counts = cKDTree(cen).query_ball_point(pts[sel], radius + reach, return_length=True)
+    return float(np.mean(counts)) / max(cen.shape[0], 1)
 
 
 def smooth_matrix(points, tri, kernel, mirror_y=False):
@@ -495,6 +503,8 @@ def sparse_radial_influence(points, tri, kernel, mirror_y=False, dense_fraction=
     if kernel.cutoff >= 2.0 * np.hypot(*(allp.max(axis=0) - allp.min(axis=0))):
         return None  # every pair (mirror images included) is within reach
     sources = [tri] + ([tri * np.array([1.0, -1.0])] if mirror_y else [])
+    if pair_fraction(pts, tri, kernel.cutoff) >= 1.2 * dense_fraction:
+        return None  # (the estimate, before the pairs are found)
     pairs = [near_pairs(pts, src, kernel.cutoff) for src in sources]
     if sum(p[0].size for p in pairs) >= dense_fraction * n * m * len(sources):
         return None

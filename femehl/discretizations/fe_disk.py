@@ -265,11 +265,13 @@ class FEDisc(P1P0):
         X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half)
         P = self.P[:, self.free]
         if X is not None:
+            self.info["radial_kernel"] = "sparse"
             return (X @ P).tocsr()
         C = self._dense_boussinesq()
         if kernel.singular != 1.0:
             C *= kernel.singular
         low = smooth_lowrank(self.centroids, self.tri, kernel, mirror_y=self.half)
+        self.info["radial_kernel"] = "dense, low-rank smooth part" if low else "dense, direct smooth part"
         if low is not None:  # a thick layer: R smooth over the whole disk
             S, K, Q = low
             C -= S @ (K @ np.asarray((P.T @ Q.T).T))

@@ -358,8 +358,13 @@ def test_refused_combinations(tmp_path):
             {"indenter": {"kind": "cylinder"}, "substrate": {"kind": "layer", "thickness": 0.5}},
             tmp_path / "c.toml",
         )
+    from femehl.discretizations.fe_line import LineDisc
+    from femehl.line import LineScene
+
     with pytest.raises(SceneError, match="method='fe'"):
-        femehl.Layer(0.5).compliance_operator(object())
+        femehl.Layer(0.5).compliance_operator(LineDisc(LineScene(k=1.0)))
+    with pytest.raises(SceneError, match="LineScene"):
+        femehl.solve(sc, method="line", t_end=0.1, dt=0.05)
 
 
 def test_exported():

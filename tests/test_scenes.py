@@ -33,6 +33,7 @@ from femehl.scene import (
     Domain,
     Fluid,
     HalfSpace,
+    Layer,
     Motion,
     RampHold,
     Rigid,
@@ -64,7 +65,12 @@ EXAMPLE_INDENTERS = {
     "heightmap": sphere_map,
     "shape": lambda: Shape(ripple),
 }
-EXAMPLE_SUBSTRATES = {"halfspace": HalfSpace(0.5), "winkler": Winkler(1.0), "rigid": Rigid()}
+EXAMPLE_SUBSTRATES = {
+    "halfspace": HalfSpace(0.5),
+    "layer": Layer(5.0, nu=0.4),  # thick: the cheap low-rank form of its operator
+    "winkler": Winkler(1.0),
+    "rigid": Rigid(),
+}
 
 
 def test_examples_cover_the_registries():
@@ -271,7 +277,7 @@ def test_combination_runs(indenter, substrate, control, sliding):
     assert st.info["couette_assembled"] is sliding is eff["sliding"]
     assert eff["imposed_load"] is (control == "load") and eff["squeeze"]
     assert bool(st.info["half"]) == ind.symmetric_y
-    if substrate == "halfspace":
+    if substrate in ("halfspace", "layer"):  # (a thick layer's operator is dense)
         assert isinstance(st.C, np.ndarray)
     else:
         assert sp.issparse(st.C) and not st.dense

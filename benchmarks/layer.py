@@ -11,7 +11,8 @@ this file:
   t = 1;
 * **set-up**: the time to build the layer's operator against the half space's dense
   build, on the medium and fine ladder meshes, and which form it took (sparse for thin
-  layers, dense with a low-rank smooth part for thick ones, dense direct between);
+  layers; dense for the others, the smooth part low-rank for thick ones, on an FFT grid or
+  direct between);
 * **accuracy**: 24 rows of each operator against a refined-quadrature reference (7-point
   rule on triangles of diameter <= h/20, polar edge integrals with 12 points on pieces of
   h/2, the direct smooth part), relative to the operator's largest entry.
@@ -34,7 +35,7 @@ from _machine import header  # noqa: E402
 HERE = Path(__file__).resolve().parent
 NU = 0.3
 THICKNESS = [0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 100.0]
-BUILD = {"medium": [100.0, 1.0, 0.3, 0.1, 0.03, 0.01], "fine": [100.0, 1.0, 0.1, 0.01]}
+BUILD = {"medium": [100.0, 1.0, 0.3, 0.1, 0.03, 0.01], "fine": [100.0, 1.0, 0.3, 0.1, 0.01]}
 
 
 def scene(substrate):

@@ -370,3 +370,15 @@ def test_refused_combinations(tmp_path):
 def test_exported():
     assert femehl.Layer is femehl.substrates.Layer
     assert femehl.substrates.SUBSTRATES["layer"] is femehl.Layer
+
+
+def test_grid_smooth_part_matches_direct(coarse):
+    """The FFT-grid smooth part (intermediate thickness) against the direct quadrature."""
+    ker = LayerKernel(0.3, 0.5)
+    P = coarse.P[:, coarse.free]
+    rows = np.arange(0, coarse.nelements, 97)
+    G = kernels.smooth_grid_apply(coarse.centroids, coarse.tri, ker, P, mirror_y=True)
+    XR = kernels.smooth_matrix(coarse.centroids[rows], coarse.tri, ker, mirror_y=True)
+    ref = np.asarray(P.T @ XR.T).T
+    # local Lagrange degree 11 on a grid of spacing h/6: measured 6e-9 .. 1e-8 (medium mesh)
+    assert np.abs(G[rows] - ref).max() <= 5e-8 * np.abs(ref).max()

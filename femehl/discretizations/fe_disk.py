@@ -29,6 +29,8 @@ from ..kernels import (
     edge_terms,
     mesh_edges,
     radial_influence,
+    smooth_cost_estimates,
+    smooth_grid_apply,
     smooth_lowrank,
     smooth_matrix,
     sparse_radial_influence,
@@ -260,7 +262,9 @@ class FEDisc(P1P0):
         leaves few pairs (a thin layer), else dense: the exact ``1/r`` part as in
         :meth:`boussinesq` minus the smooth part, by a low-rank Chebyshev interpolation
         where R is smooth over the whole disk (:func:`femehl.kernels.smooth_lowrank`, a
-        thick layer), else directly (:func:`femehl.kernels.smooth_matrix`).
+        thick layer), else on a uniform grid with an FFT convolution
+        (:func:`femehl.kernels.smooth_grid_apply`) or directly
+        (:func:`femehl.kernels.smooth_matrix`), whichever is estimated cheaper.
         """
         X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half)
         P = self.P[:, self.free]
@@ -271,11 +275,17 @@ class FEDisc(P1P0):
         if kernel.singular != 1.0:
             C *= kernel.singular
         low = smooth_lowrank(self.centroids, self.tri, kernel, mirror_y=self.half)
-        self.info["radial_kernel"] = "dense, low-rank smooth part" if low else "dense, direct smooth part"
         if low is not None:  # a thick layer: R smooth over the whole disk
+            self.info["radial_kernel"] = "dense, low-rank smooth part"
             S, K, Q = low
             C -= S @ (K @ np.asarray((P.T @ Q.T).T))
+            return C
+        direct, grid = smooth_cost_estimates(self.centroids, self.tri, kernel, self.half, ncols=self.n)
+        if grid < direct:  # between: R on a uniform grid, the convolution by FFT
+            self.info["radial_kernel"] = "dense, grid smooth part"
+            C -= smooth_grid_apply(self.centroids, self.tri, kernel, P, mirror_y=self.half)
         else:
+            self.info["radial_kernel"] = "dense, direct smooth part"
             XR = smooth_matrix(self.centroids, self.tri, kernel, mirror_y=self.half)
             C -= np.asarray(P.T @ XR.T).T
         return C

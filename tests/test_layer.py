@@ -382,3 +382,17 @@ def test_grid_smooth_part_matches_direct(coarse):
     ref = np.asarray(P.T @ XR.T).T
     # local Lagrange degree 11 on a grid of spacing h/6: measured 6e-9 .. 1e-8 (medium mesh)
     assert np.abs(G[rows] - ref).max() <= 5e-8 * np.abs(ref).max()
+
+
+def test_thick_layer_run_approaches_the_half_space():
+    """The paper case (indentation to t = 0.5, coarse mesh) on Layer(h) -> HalfSpace as h grows."""
+    sc = femehl.presets.paper_sphere()
+    run = dict(t_end=0.5, dt=0.05, mesh="coarse", linear_solver="lu")
+    ref = femehl.solve(sc, **run)
+    err = []
+    for h in (100.0, 1000.0):
+        r = femehl.solve(dataclasses.replace(sc, substrate=femehl.Layer(h)), **run)
+        err.append(np.abs(r.load - ref.load).max() / np.abs(ref.load).max())
+    # the layer is stiffer by O(contact/h): load 8.3e-3 at h = 100, ten times less at 1000
+    assert err[0] < 1e-2
+    assert err[1] == pytest.approx(err[0] / 10, rel=0.1)

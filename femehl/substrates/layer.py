@@ -23,7 +23,9 @@ The operator (FE and FD): the exact ``1/r`` integral of the discretized pressure
 each element minus the integral of ``R`` (:meth:`femehl.discretizations.fe_disk.FEDisc.radial_kernel`):
 sparse for a thin layer (pairs beyond the cut-off are zero), dense otherwise.  The fast
 hierarchical operator (``operator="fast"``) is the half space's only; line contact takes
-local substrates only.
+local substrates only.  Under an imposed load the scene's check that the domain holds the
+contact uses the half space's dry-contact estimate (``compliance``): the layer is stiffer,
+so the check is conservative.
 """
 
 from __future__ import annotations

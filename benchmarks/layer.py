@@ -18,7 +18,7 @@ this file:
   h/2, the direct smooth part), relative to the operator's largest entry.
 
 Threads pinned to one.  The raw results go to ``layer.json``; ``--table-only`` rebuilds
-the table from it.
+the table from it, ``--builds-only`` measures the set-up again and keeps its limits.
 """
 
 from __future__ import annotations
@@ -123,13 +123,18 @@ def build_and_accuracy():
     return out
 
 
-def main(table_only=False):
-    """Run (or, with ``table_only``, reuse ``layer.json``) and write ``layer.md``."""
+def main(table_only=False, builds_only=False):
+    """Run (or, with ``table_only``, reuse ``layer.json``; ``builds_only``: reuse its
+    limits, measure the set-up again) and write ``layer.md``."""
     import json
 
     raw = HERE / "layer.json"
     if table_only:
         data = json.loads(raw.read_text())
+    elif builds_only:
+        data = json.loads(raw.read_text())
+        data["builds"] = build_and_accuracy()
+        raw.write_text(json.dumps(data, indent=1) + "\n")
     else:
         half, rows = limits()
         data = {"half": half, "rows": rows, "builds": build_and_accuracy()}
@@ -197,4 +202,4 @@ def main(table_only=False):
 if __name__ == "__main__":
     import sys
 
-    main(table_only="--table-only" in sys.argv[1:])
+    main(table_only="--table-only" in sys.argv[1:], builds_only="--builds-only" in sys.argv[1:])

@@ -203,14 +203,28 @@ def test_thick_layer_is_the_half_space(coarse):
 
 def test_rows_agree_with_operator(coarse):
     # a thick layer's operator takes the low-rank smooth part (interpolation error <= 1e-9
-    # of R(0) per pair), its rows the direct one; a thin one is sparse, rows and all
-    for sub, tol in ((femehl.Layer(1.0), 1e-7), (femehl.Layer(0.02, nu=0.3), 1e-12)):
+    # of R(0) per pair), an intermediate one the FFT grid (<= 1e-8), its rows the direct
+    # quadrature; thinner ones the pairs within the cut-off (dense or sparse), rows and all
+    forms = {}
+    for sub, tol in (
+        (femehl.Layer(1.0), 1e-7),
+        (femehl.Layer(0.3), 5e-8),
+        (femehl.Layer(0.02, nu=0.3), 1e-12),
+        (femehl.Layer(0.005, nu=0.3), 1e-12),
+    ):
         C = sub.compliance_operator(coarse)
+        forms[sub.thickness] = coarse.info["radial_kernel"]
         C = C.toarray() if hasattr(C, "toarray") else C
         rows = sub.deflection_rows(coarse, coarse.centroids[:12])
         rows = rows.toarray() if hasattr(rows, "toarray") else rows
         assert np.allclose(rows, C[:12], rtol=0, atol=tol * np.abs(C).max())
     assert sub.deflection_rows(coarse, [[0.0, 0.0]]).shape == (1, coarse.n)
+    assert forms == {
+        1.0: "dense, low-rank smooth part",
+        0.3: "dense, grid smooth part",
+        0.02: "dense, pairs within the cut-off",
+        0.005: "sparse",
+    }
 
 
 def _gaussian(points, s):

@@ -263,31 +263,44 @@ class FEDisc(P1P0):
         :meth:`boussinesq` minus the smooth part, by a low-rank Chebyshev interpolation
         where R is smooth over the whole disk (:func:`femehl.kernels.smooth_lowrank`, a
         thick layer), else on a uniform grid with an FFT convolution
-        (:func:`femehl.kernels.smooth_grid_apply`) or directly
-        (:func:`femehl.kernels.smooth_matrix`), whichever is estimated cheaper.
+        (:func:`femehl.kernels.smooth_grid_apply`) or directly, whichever is estimated
+        cheaper; directly means the pairs within the cut-off where they are fewer than 80 %
+        of all, else :func:`femehl.kernels.smooth_matrix`.
         """
         X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half)
         P = self.P[:, self.free]
         if X is not None:
             self.info["radial_kernel"] = "sparse"
             return (X @ P).tocsr()
-        C = self._dense_boussinesq()
-        if kernel.singular != 1.0:
-            C *= kernel.singular
+
+        def singular():
+            C = self._dense_boussinesq()
+            if kernel.singular != 1.0:
+                C *= kernel.singular
+            return C
+
         low = smooth_lowrank(self.centroids, self.tri, kernel, mirror_y=self.half)
         if low is not None:  # a thick layer: R smooth over the whole disk
             self.info["radial_kernel"] = "dense, low-rank smooth part"
             S, K, Q = low
+            C = singular()
             C -= S @ (K @ np.asarray((P.T @ Q.T).T))
             return C
         direct, grid = smooth_cost_estimates(self.centroids, self.tri, kernel, self.half, ncols=self.n)
         if grid < direct:  # between: R on a uniform grid, the convolution by FFT
             self.info["radial_kernel"] = "dense, grid smooth part"
+            C = singular()
             C -= smooth_grid_apply(self.centroids, self.tri, kernel, P, mirror_y=self.half)
-        else:
-            self.info["radial_kernel"] = "dense, direct smooth part"
-            XR = smooth_matrix(self.centroids, self.tri, kernel, mirror_y=self.half)
-            C -= np.asarray(P.T @ XR.T).T
+            return C
+        # direct: only the pairs within the cut-off if they are fewer (h ~ 1/30 of the disk)
+        X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half, dense_fraction=0.8)
+        if X is not None:
+            self.info["radial_kernel"] = "dense, pairs within the cut-off"
+            return np.asarray((X @ P).toarray())
+        self.info["radial_kernel"] = "dense, direct smooth part"
+        C = singular()
+        XR = smooth_matrix(self.centroids, self.tri, kernel, mirror_y=self.half)
+        C -= np.asarray(P.T @ XR.T).T
         return C
 
     def radial_kernel_rows(self, kernel, points):

@@ -16,9 +16,12 @@ normal pressure on its frictionless top surface, multiplies that transform by ``
     frictionless base (u_z = 0, sigma_xz = 0 at z = -h):
         K(t) = [cosh(2t) - 1] / [sinh(2t) + 2t]      (independent of nu).
 
-These are the standard layer compliances (Johnson, *Contact Mechanics*, 1985, section
-5.9 and the layer solutions it cites; the bonded one in this form is the one used by
-Chandler & Vella, Proc. R. Soc. A 476, 2020, for soft lubrication on finite layers).
+These are the classical layer compliances (layers on a rigid base: Johnson, *Contact
+Mechanics*, 1985, section 5.9 and the solutions it cites); the thin-layer limits below,
+Winkler for a compressible layer and ``lap p`` for an incompressible one, and when each
+holds, are discussed by Chandler & Vella, "Validity of Winkler's mattress model for thin
+elastomeric layers: beyond Poisson's ratio", Proc. R. Soc. A (2020), arXiv:2010.11133,
+with soft EHL as an example.  femehl does not rely on a printed formula:
 ``tests/test_layer.py`` re-derives both numerically: a Fourier mode of the load makes a
 plane-strain problem in (x, z), whose Navier equations are integrated as a first-order
 system for (u_x, u_z, sigma_xz, sigma_zz) across the layer by a matrix exponential and

@@ -17,7 +17,7 @@ normal pressure on its frictionless top surface, multiplies that transform by ``
         K(t) = [cosh(2t) - 1] / [sinh(2t) + 2t]      (independent of nu).
 
 These are the classical layer compliances (layers on a rigid base: Johnson, *Contact
-Mechanics*, 1985, section 5.9 and the solutions it cites); the thin-layer limits below,
+Mechanics*, 1985, and the layered-solid solutions it cites); the thin-layer limits below,
 Winkler for a compressible layer and ``lap p`` for an incompressible one, and when each
 holds, are discussed by Chandler & Vella, "Validity of Winkler's mattress model for thin
 elastomeric layers: beyond Poisson's ratio", Proc. R. Soc. A (2020), arXiv:2010.11133,

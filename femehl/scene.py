@@ -39,7 +39,7 @@ import numpy as np
 
 from .errors import SceneError
 from .indenters import Sphere  # indenters live in femehl.indenters; Sphere stays importable here
-from .substrates import HalfSpace, Rigid, Winkler  # noqa: F401  (re-exported)
+from .substrates import HalfSpace, Layer, Rigid, Winkler  # noqa: F401  (re-exported)
 
 # the validators live in femehl.validation; re-exported here (other modules import them from scene)
 from .validation import _short, call_time_function, check_finite, check_positive, check_shape_values
@@ -50,6 +50,7 @@ __all__ = [
     "Domain",
     "Fluid",
     "HalfSpace",
+    "Layer",
     "Motion",
     "RampHold",
     "Rigid",
@@ -215,7 +216,7 @@ def _as_time_function(name: str, f) -> Callable[[float], float]:
 # --------------------------------------------------------------------------
 # substrates
 # --------------------------------------------------------------------------
-# HalfSpace, Rigid, Winkler live in femehl.substrates (each owns its operator)
+# HalfSpace, Layer, Rigid, Winkler live in femehl.substrates (each owns its operator)
 
 
 # --------------------------------------------------------------------------
@@ -430,7 +431,7 @@ class Scene(SceneEffects):
     """Everything a solver needs to know about the physics, in normalized units."""
 
     indenter: Sphere = field(default_factory=Sphere)
-    substrate: HalfSpace | Rigid | Winkler = field(default_factory=HalfSpace)
+    substrate: HalfSpace | Layer | Rigid | Winkler = field(default_factory=HalfSpace)
     fluid: Fluid = field(default_factory=Fluid)
     motion: Motion = field(default_factory=Motion)
     domain: Domain = field(default_factory=Domain)

@@ -9,6 +9,8 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           | "heightmap" (file = "map.npz" | x, y, z [, symmetric_y])
                           | "cylinder" (R = 1 only): line contact, see below
     [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
+                          | "layer" (thickness, nu, bonded): an elastic layer on a
+                          rigid base, thickness in the units of x and y
     [fluid]               beta = 200.0
                           cavitation = "reynolds" (optional: p >= 0) | "half-sommerfeld"
                           (negative pressures clipped after the full-Sommerfeld
@@ -40,7 +42,8 @@ relative to the scene file; so is a [run] mesh that is not a ladder name
 only in Python.
 
 Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
-load, alpha (Barus, 1/Pa) or roelands_Z (Roelands, with eta as eta0)]) states the
+load, alpha (Barus, 1/Pa) or roelands_Z (Roelands, with eta as eta0), layer_thickness
+(m: a bonded elastic layer of that thickness on a rigid base, with the [si] nu)]) states the
 paper's experiment in SI units and replaces the tables above, except ``[indenter]``,
 which may then give an analytic shape in metres (R of [si] is the normalizing radius
 of curvature; ``load`` [N] imposes a constant load instead of the gap ramp).  ``femehl run`` then also writes
@@ -278,22 +281,8 @@ def _si_scene(raw, path):
         raise SceneFileError(f"{path}: [si] must be a table.")
     si = dict(si)
     visco = {"G0", "tau", "G_inf"}  # a standard linear solid: unrelaxed modulus, relaxation time
-    keys = {
-        "R",
-        "G",
-        "eta",
-        "V_ss",
-        "h_inf",
-        "nu",
-        "h0",
-        "t1",
-        "T",
-        "L",
-        "load",
-        "alpha",
-        "roelands_Z",
-    } | visco
-    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z"} | visco
+    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco
+    keys = {"R", "G", "eta", "V_ss", "h_inf", "h0"} | optional
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
     if extra or missing:
@@ -312,6 +301,15 @@ def _si_scene(raw, path):
             ind = dict(ind)
             kind = ind.pop("kind", None)
             changes["indenter"] = si_indenter(kind, ind, dim)
+        if "layer_thickness" in si:  # an elastic layer on a rigid base, thickness in metres
+            from .substrates import Layer
+
+            h = check_finite("[si] layer_thickness [m]", si["layer_thickness"])
+            if h <= 0.0:
+                raise SceneError(
+                    f"[si] layer_thickness must be > 0 (metres), got {h:g}; leave it out for a half space."
+                )
+            changes["substrate"] = Layer(h / dim.length, nu=dim.nu)
         if "load" in si:
             F = check_finite("[si] load [N]", si["load"]) / dim.force
             changes["motion"] = Motion(

@@ -75,6 +75,12 @@ def test_readme_block_runs(index, tmp_path, monkeypatch, capsys, paper_reference
         (hs_load, hs_full, hs_area), (re_area, re_source) = _floats(out[0]), _floats(out[1])
         assert hs_load > 1.02 * hs_full and hs_area > 1.0
         assert re_area > 1.0 and re_source > 0.0
+    elif "femehl.Layer(thickness" in python_blocks()[index]:
+        # the coated contact: a layer as thick as the contact is stiffer than the half space,
+        # so the same indentation carries more load (same mesh, dt and horizon)
+        load, film_center = _floats(out[0])
+        half = femehl.solve(femehl.presets.paper_sphere(), t_end=0.5, dt=0.05, mesh="coarse")
+        assert load > 1.05 * half.load[-1] and film_center > 0
     elif "Viscoelastic(" in python_blocks()[index]:
         # the viscoelastic block at t = 2 (V = tanh 1, still accelerating, so the steady
         # balance f V = D_film + P does not hold yet: it is tested at steady sliding in

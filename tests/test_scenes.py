@@ -33,6 +33,7 @@ from femehl.scene import (
     Domain,
     Fluid,
     HalfSpace,
+    Layer,
     Motion,
     RampHold,
     Rigid,
@@ -66,6 +67,7 @@ EXAMPLE_INDENTERS = {
 }
 EXAMPLE_SUBSTRATES = {
     "halfspace": HalfSpace(0.5),
+    "layer": Layer(5.0, nu=0.4),  # thick: the cheap low-rank form of its operator
     "winkler": Winkler(1.0),
     "rigid": Rigid(),
     "viscoelastic": femehl.Viscoelastic(G0=2.0, tau=0.1),
@@ -276,7 +278,7 @@ def test_combination_runs(indenter, substrate, control, sliding):
     assert st.info["couette_assembled"] is sliding is eff["sliding"]
     assert eff["imposed_load"] is (control == "load") and eff["squeeze"]
     assert bool(st.info["half"]) == ind.symmetric_y
-    if substrate in ("halfspace", "viscoelastic"):  # (the viscoelastic one relaxes a half space)
+    if substrate in ("halfspace", "layer", "viscoelastic"):  # dense (a thick layer; a relaxing half space)
         assert isinstance(st.C, np.ndarray)
     else:
         assert sp.issparse(st.C) and not st.dense

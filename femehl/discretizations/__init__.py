@@ -22,7 +22,9 @@ What a discretization provides (all built once, from the scene):
   test rows), ``couette()`` and ``squeeze()`` (sparse n x nf: ``-d/dx`` and the mass of
   a film-point field, as in the weak form), see :mod:`femehl.core.terms`;
 * for substrates: ``average()`` (sparse nf x n), ``pressure_rows(points)`` (sparse),
-  ``boussinesq()`` (dense nf x n) and ``boussinesq_rows(points)`` (dense);
+  ``boussinesq()`` (dense nf x n) and ``boussinesq_rows(points)`` (dense); optionally
+  ``radial_kernel(kernel)`` / ``radial_kernel_rows(kernel, points)`` (a radial kernel
+  ``a/r - R(r)``, R smooth: an elastic layer; "fe" and "fd" have them);
 * for the film check: ``node_average`` (sparse N x nf, or None when the film points are
   the nodes) and ``node_shape``;
 * for results and writers: ``pressure_at``, ``film_at``, ``deflection_at``,

@@ -251,6 +251,25 @@ class FDDisc:
         chi += quad_influence(points, mirror)
         return np.asarray(self.E.T @ chi.T).T
 
+    def _cell_triangles(self):
+        q = self.grid.cells()
+        return np.concatenate([q[:, [0, 1, 2], :], q[:, [0, 2, 3], :]])  # (2 m n, 3, 2)
+
+    def radial_kernel(self, kernel):
+        """``chi_g E``: a radial kernel ``singular/r - R`` integrated over every polar cell
+        (two triangles) and its mirror image; sparse for a kernel with a short cut-off."""
+        return self.radial_kernel_rows(kernel, self.nodes)
+
+    def radial_kernel_rows(self, kernel, points):
+        from ..kernels import radial_influence
+
+        X = radial_influence(points, self._cell_triangles(), kernel, mirror_y=True)
+        nc = X.shape[1] // 2
+        if sp.issparse(X):
+            X = X.tocsc()
+            return ((X[:, :nc] + X[:, nc:]) @ self.E).tocsr()
+        return np.asarray(self.E.T @ (X[:, :nc] + X[:, nc:]).T).T
+
     def outside(self, points):
         """True where a point lies beyond the domain r <= L."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)

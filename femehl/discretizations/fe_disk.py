@@ -25,7 +25,17 @@ from skfem import Basis, ElementTriP0, ElementTriP1
 from ..errors import SceneError
 from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
-from ..kernels import edge_terms, mesh_edges, triangle_influence
+from ..kernels import (
+    edge_terms,
+    mesh_edges,
+    radial_influence,
+    smooth_cost_estimates,
+    smooth_grid_apply,
+    smooth_lowrank,
+    smooth_matrix,
+    sparse_radial_influence,
+    triangle_influence,
+)
 from ..validation import check_operator_tol
 from . import register_method
 from ._p1p0 import P1P0
@@ -150,8 +160,22 @@ class FEDisc(P1P0):
         """The operator to build, checked against the machine's memory."""
         from ..fe.mesh import check_mesh_memory, dense_fits
 
+        sub = self.scene.substrate
+        allowed = getattr(sub, "operators", OPERATORS)
+        if operator == "fast" and "fast" not in allowed:
+            raise SceneError(
+                f"the fast hierarchical operator approximates the half space's 1/r kernel only; "
+                f"a {type(sub).__name__} substrate needs operator='dense' (or 'auto')."
+            )
         if operator == "auto":
-            operator = "fast" if ne >= FAST_CROSSOVER or not dense_fits(ne, self.n) else "dense"
+            big = ne >= FAST_CROSSOVER or not dense_fits(ne, self.n)
+            operator = "fast" if big and "fast" in allowed else "dense"
+            if big and "fast" not in allowed and not dense_fits(ne, self.n):
+                raise SceneError(
+                    f"mesh {self.dm.name}: {ne} elements need a dense elastic operator that does not "
+                    f"fit in this machine's memory, and a {type(sub).__name__} substrate has no fast "
+                    "operator: use a coarser mesh (a ladder name or larger mesh sizes)."
+                )
         check_mesh_memory(ne, self.n, self.dm.name, operator=operator)
         return operator
 
@@ -212,6 +236,9 @@ class FEDisc(P1P0):
             from ..hmatrix import FastCompliance
 
             return FastCompliance(self, tol=self.operator_tol)
+        return self._dense_boussinesq()
+
+    def _dense_boussinesq(self):
         ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
         SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse
@@ -225,6 +252,65 @@ class FEDisc(P1P0):
                 T -= edge_terms(self.centroids[e], mirror, edges)
             C[e] = (SP.T @ T.T).T
         return C
+
+    def radial_kernel(self, kernel):
+        """``X_g P[:, free]``, ``X_g[i, e] = int_{T_e} g(|c_i - x'|) dA'``, mirror included.
+
+        ``g = kernel.singular / r - R(r)`` with R smooth (the radial-kernel protocol of
+        :func:`femehl.kernels.radial_triangle_pairs`, e.g. an elastic layer's
+        :class:`femehl.layer_kernel.LayerKernel`).  Sparse (CSR) when the kernel's cut-off
+        leaves few pairs (a thin layer), else dense: the exact ``1/r`` part as in
+        :meth:`boussinesq` minus the smooth part, by a low-rank Chebyshev interpolation
+        where R is smooth over the whole disk (:func:`femehl.kernels.smooth_lowrank`, a
+        thick layer), else on a uniform grid with an FFT convolution
+        (:func:`femehl.kernels.smooth_grid_apply`) or directly, whichever is estimated
+        cheaper; directly means the pairs within the cut-off where they are fewer than 80 %
+        of all, else :func:`femehl.kernels.smooth_matrix`.
+        """
+        X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half)
+        P = self.P[:, self.free]
+        if X is not None:
+            self.info["radial_kernel"] = "sparse"
+            return (X @ P).tocsr()
+
+        def singular():
+            C = self._dense_boussinesq()
+            if kernel.singular != 1.0:
+                C *= kernel.singular
+            return C
+
+        low = smooth_lowrank(self.centroids, self.tri, kernel, mirror_y=self.half)
+        if low is not None:  # a thick layer: R smooth over the whole disk
+            self.info["radial_kernel"] = "dense, low-rank smooth part"
+            S, K, Q = low
+            C = singular()
+            C -= S @ (K @ np.asarray((P.T @ Q.T).T))
+            return C
+        direct, grid = smooth_cost_estimates(self.centroids, self.tri, kernel, self.half, ncols=self.n)
+        if grid < direct:  # between: R on a uniform grid, the convolution by FFT
+            self.info["radial_kernel"] = "dense, grid smooth part"
+            C = singular()
+            C -= smooth_grid_apply(self.centroids, self.tri, kernel, P, mirror_y=self.half)
+            return C
+        # direct: only the pairs within the cut-off if they are fewer (h ~ 1/30 of the disk)
+        X = sparse_radial_influence(self.centroids, self.tri, kernel, mirror_y=self.half, dense_fraction=0.8)
+        if X is not None:
+            self.info["radial_kernel"] = "dense, pairs within the cut-off"
+            return np.asarray((X @ P).toarray())
+        self.info["radial_kernel"] = "dense, direct smooth part"
+        C = singular()
+        XR = smooth_matrix(self.centroids, self.tri, kernel, mirror_y=self.half)
+        C -= np.asarray(P.T @ XR.T).T
+        return C
+
+    def radial_kernel_rows(self, kernel, points):
+        """Rows of :meth:`radial_kernel` at arbitrary points (mirror image included)."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        X = radial_influence(pts, self.tri, kernel, mirror_y=self.half)
+        P = self.P[:, self.free]
+        if sp.issparse(X):
+            return (X @ P).tocsr()
+        return np.asarray(P.T @ X.T).T
 
     def boussinesq_rows(self, points):
         """Rows of :meth:`boussinesq` at arbitrary points (mirror image included)."""

@@ -14,16 +14,28 @@ discretization offers (:mod:`femehl.discretizations`):
 
 The primitives are ``disc.boussinesq()`` / ``disc.boussinesq_rows(points)`` (exact
 integral of ``1/|x - x'|`` of the discretized unit pressure, mirror image included for a
-half domain), ``disc.average()`` (the pressure's value on the film points) and
-``disc.pressure_rows(points)``.  A new substrate is one module defining such a class; no
+half domain), ``disc.average()`` (the pressure's value on the film points),
+``disc.pressure_rows(points)`` and, for a radial kernel ``singular/r - R(r)`` with R smooth
+(an elastic layer, :class:`Layer`), ``disc.radial_kernel(kernel)`` /
+``disc.radial_kernel_rows(kernel, points)``.  A new substrate is one module defining such a class; no
 solver file changes; decorated with :func:`register_substrate` its ``kind`` also names
 it in TOML scene files (``[substrate] kind = "..."``).
 """
 
 from .base import SUBSTRATES, Substrate, register_substrate
 from .halfspace import HalfSpace
+from .layer import Layer
 from .rigid import Rigid
 from .viscoelastic import Viscoelastic
 from .winkler import Winkler
 
-__all__ = ["Substrate", "SUBSTRATES", "register_substrate", "HalfSpace", "Winkler", "Rigid", "Viscoelastic"]
+__all__ = [
+    "Substrate",
+    "SUBSTRATES",
+    "register_substrate",
+    "HalfSpace",
+    "Layer",
+    "Winkler",
+    "Rigid",
+    "Viscoelastic",
+]

@@ -115,7 +115,17 @@ def check_ball_drop(mod, tmp_path):
     assert row["energy_drift"] < 4e-3 and row["indentation_um"] > 50
 
 
+def check_coated_contact(mod, tmp_path):
+    """Under the same load, a coating as thick as the contact (h = 1) is stiffer than the
+    half space: shallower indentation (hc -0.44 against -0.96 at t = 5) and a thinner
+    film; shortened here to t = 2 (sliding started)."""
+    half, coat = mod.main(out=tmp_path, thicknesses=(1.0,), t_end=2.0)
+    assert half["thickness"] is None and coat["thickness"] == 1.0
+    assert coat["hc"] > 0.7 * half["hc"] and coat["film_min"] < half["film_min"]
+
+
 CHECKS = {
+    "coated_contact": check_coated_contact,
     "ball_drop": check_ball_drop,
     "rubber_slider": check_rubber_slider,
     "load_controlled": check_load_controlled,
@@ -138,7 +148,7 @@ def test_example_runs(name, tmp_path, capsys):
         assert (tmp_path / "summary.csv").exists()
 
 
-@pytest.mark.parametrize("name", ["load_controlled", "ellipsoid_sliding"])
+@pytest.mark.parametrize("name", ["load_controlled", "ellipsoid_sliding", "coated_contact"])
 def test_toml_twin_is_the_same_scene(name, tmp_path):
     sc, run = load_scene_file(EXAMPLES / f"{name}.toml")
     assert sc == load_example(name).scene()

@@ -43,7 +43,11 @@ only in Python.
 
 Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
 load, alpha (Barus, 1/Pa) or roelands_Z (Roelands, with eta as eta0), layer_thickness
-(m: a bonded elastic layer of that thickness on a rigid base, with the [si] nu)]) states the
+(m: a bonded elastic layer of that thickness on a rigid base, with the [si] nu), G0 and
+tau (Pa, s: a viscoelastic standard linear solid; optional G_inf, Pa, default G), mass,
+force, hc_dot0 (kg, N, m/s: a free indenter starting at h0 with that dhc/dt), sliding
+(false: no sliding, V = 0; V_ss then only sets the time scale), cavitation (as in
+[fluid])]) states the
 paper's experiment in SI units and replaces the tables above, except ``[indenter]``,
 which may then give an analytic shape in metres (R of [si] is the normalizing radius
 of curvature; ``load`` [N] imposes a constant load instead of the gap ramp).  ``femehl run`` then also writes
@@ -72,7 +76,7 @@ from .scene import (
     Table,
     TanhStart,
 )
-from .validation import check_finite, check_int
+from .validation import check_finite, check_int, check_positive
 
 try:
     import tomllib
@@ -281,7 +285,9 @@ def _si_scene(raw, path):
         raise SceneFileError(f"{path}: [si] must be a table.")
     si = dict(si)
     visco = {"G0", "tau", "G_inf"}  # a standard linear solid: unrelaxed modulus, relaxation time
-    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco
+    free = {"mass", "force", "hc_dot0", "sliding"}  # a free indenter: kg, N, m/s; sliding on/off
+    free |= {"cavitation"}  # the fluid's cavitation condition (as [fluid] cavitation)
+    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco | free
     keys = {"R", "G", "eta", "V_ss", "h_inf", "h0"} | optional
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
@@ -328,6 +334,28 @@ def _si_scene(raw, path):
             else:
                 model = Barus.from_si(si["alpha"], dim)
             changes["fluid"] = dataclasses.replace(scene.fluid, viscosity=model)
+        if "sliding" in si and not isinstance(si["sliding"], bool):
+            raise SceneFileError(f"{path}: [si] sliding must be true or false, got {si['sliding']!r}.")
+        if free & set(si) - {"sliding", "cavitation"}:  # a free indenter (Newton's law), in SI
+            if "mass" not in si or "load" in si:
+                raise SceneFileError(
+                    f"{path}: [si] a free indenter needs mass [kg] (with optional force [N] and "
+                    "hc_dot0 [m/s], the initial dhc/dt, < 0 toward the substrate), and no load."
+                )
+            m = check_positive("[si] mass [kg]", si["mass"], "Give the indenter's mass in kg.")
+            changes["motion"] = Motion(
+                gap=Constant(check_positive("[si] h0 [m]", si["h0"]) / dim.height),
+                velocity=scene.motion.velocity,
+                mass=m / dim.mass,
+                force=check_finite("[si] force [N]", si.get("force", 0.0)) / dim.force,
+                hc_dot0=check_finite("[si] hc_dot0 [m/s]", si.get("hc_dot0", 0.0)) / dim.approach_speed,
+            )
+        if "cavitation" in si:
+            fluid = changes.get("fluid", scene.fluid)
+            changes["fluid"] = dataclasses.replace(fluid, cavitation=si["cavitation"])
+        if si.get("sliding", True) is False:  # no sliding: the indenter only approaches
+            mo = changes.get("motion", scene.motion)
+            changes["motion"] = dataclasses.replace(mo, velocity=Constant(0.0))
         if visco & set(si):
             if not {"G0", "tau"} <= set(si):
                 raise SceneFileError(

@@ -170,6 +170,18 @@ def test_toml_twin_is_the_same_scene(name, tmp_path):
     assert rc == 0 and (tmp_path / "summary.csv").exists()
 
 
+def test_ball_drop_toml_is_the_example():
+    """The SI scene file states the example's U = 0.05 m/s case (free indenter, no sliding)."""
+    sc, run = load_scene_file(EXAMPLES / "ball_drop.toml")
+    py, _dim = load_example("ball_drop").scene(0.05)
+    assert sc.fluid == py.fluid and sc.domain == py.domain and sc.substrate == py.substrate
+    assert sc.motion.velocity(2.0) == 0.0 and sc.motion.hc(0.0) == pytest.approx(py.motion.hc(0.0))
+    for q in ("mass", "hc_dot0"):
+        assert getattr(sc.motion, q) == pytest.approx(getattr(py.motion, q), rel=1e-9)
+    assert sc.motion.applied_force(0.0) == pytest.approx(py.motion.applied_force(0.0), rel=1e-9)
+    assert run["_dimensional"].V_ss == 0.05
+
+
 def test_sphere_si_toml():
     sc, run = load_scene_file(EXAMPLES / "sphere_si.toml")
     dim = run.pop("_dimensional")

@@ -182,3 +182,26 @@ def test_collision_energy_budget_closes_to_the_time_error():
         assert total[0] == pytest.approx(0.5 * 0.05 * 1.0)
         drift.append(np.max(np.abs(total / total[0] - 1.0)))
     assert drift[1] < 0.025 and 3.0 < drift[0] / drift[1] < 5.0
+
+
+@pytest.mark.parametrize(
+    "extra,words",
+    [
+        ("mass = 1e-3\nload = 0.01\n", "no load"),
+        ("force = 1e-3\n", "needs mass"),
+        ("mass = -1e-3\n", "mass"),
+        ("sliding = 1\n", "true or false"),
+    ],
+)
+def test_bad_si_free_indenter(tmp_path, extra, words):
+    import pathlib
+
+    from femehl.errors import SceneFileError
+    from femehl.scenefile import load_scene_file
+
+    src = (pathlib.Path(__file__).parents[1] / "examples" / "ball_drop.toml").read_text()
+    start, end = src.index("mass ="), src.index("sliding = false\n") + len("sliding = false\n")
+    f = tmp_path / "s.toml"
+    f.write_text(src[:start] + extra + src[end:])
+    with pytest.raises(SceneFileError, match=words):
+        load_scene_file(f)

@@ -570,6 +570,15 @@ def _lagrange(x, nodes):
     return L
 
 
+def _mirrored_source_points(tri, kernel, mirror_y):
+    """:func:`_source_points`, with their mirror images in y = 0 appended when ``mirror_y``."""
+    xq, wq, owner = _source_points(tri, kernel)
+    if mirror_y:
+        xq = np.vstack([xq, xq * np.array([1.0, -1.0])])
+        wq, owner = np.r_[wq, wq], np.r_[owner, owner]
+    return xq, wq, owner
+
+
 def _source_points(tri, kernel):
     """Gauss points (7 per piece) and weights of triangles, each split into k^2 congruent
     pieces of diameter <= SMALL_TRIANGLE * scale: (points (q, 2), weights (q,), triangle (q,))."""
@@ -618,10 +627,7 @@ def smooth_lowrank(points, tri, kernel, mirror_y=False, tol=1e-9, max_p=LOWRANK_
     """
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     tri = np.asarray(tri, dtype=float).reshape(-1, 3, 2)
-    xq, wq, owner = _source_points(tri, kernel)
-    if mirror_y:
-        xq = np.vstack([xq, xq * np.array([1.0, -1.0])])
-        wq, owner = np.r_[wq, wq], np.r_[owner, owner]
+    xq, wq, owner = _mirrored_source_points(tri, kernel, mirror_y)
     allp = np.vstack([pts, xq])
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     W = 0.5 * float(np.max(hi - lo))
@@ -703,10 +709,7 @@ def smooth_grid_apply(points, tri, kernel, columns, mirror_y=False, batch=64):
 
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     tri = np.asarray(tri, dtype=float).reshape(-1, 3, 2)
-    xq, wq, owner = _source_points(tri, kernel)
-    if mirror_y:
-        xq = np.vstack([xq, xq * np.array([1.0, -1.0])])
-        wq, owner = np.r_[wq, wq], np.r_[owner, owner]
+    xq, wq, owner = _mirrored_source_points(tri, kernel, mirror_y)
     q = GRID_DEGREE
     d = kernel.scale / GRID_PER_SCALE
     allp = np.vstack([pts, xq])

@@ -178,7 +178,8 @@ def main():
         "## 4. Mesh convergence and cost per step",
         "",
         "tau = 0.5, L = 2, t = 8, dt = 0.04, BDF2, dense operator, one thread; the elastic "
-        "(J = 1) run on the same mesh in the same process for the cost ratio.",  # (md: noise note)
+        "(J = 1) run on the same mesh in the same process for the cost ratio (noisy when another "
+        "process shares the machine).",
         "",
         "| mesh | elements | film centre | film min | friction | P_solid | s/step | elastic s/step | ratio |",
         "|---|---|---|---|---|---|---|---|---|",

@@ -210,7 +210,8 @@ class CreepMemory:
 
     The internal variable lives on a uniform grid aligned with the sliding direction
     (spacing that of the film points in the finest part of the mesh -- the 5th
-    percentile of nearest-neighbour distances --, at most :data:`MAX_COLUMNS` columns), where the
+    percentile of nearest-neighbour distances --, at most :data:`MAX_COLUMNS` columns;
+    twice that across, where nothing is transported), where the
     transport along x is a cubic-spline shift (error O(dx^4) per step: no numerical
     diffusion to speak of).  The step's source ``u = C p`` reaches the grid by linear
     interpolation from the film points (a Delaunay triangulation of them, mirrored for a
@@ -247,7 +248,7 @@ class CreepMemory:
         else:
             y0 = 0.0 if self.half else float(P[:, 1].min())
             y1 = float(P[:, 1].max())
-            ny = int(max(2, np.ceil((y1 - y0) / self.dx) + 1))
+            ny = int(max(2, np.ceil((y1 - y0) / (2.0 * self.dx)) + 1))  # no transport along y
             self.y0, self.dy = y0, (y1 - y0) / (ny - 1)
         self.shape = (ny, nx)
         gx = x0 + self.dx * np.arange(nx)

@@ -57,8 +57,9 @@ def _march_memory(mem, f, V, scheme, dt, t_end):
 def test_memory_is_carried_with_the_material():
     """Steady ``-2 V tau_c q_x = dJ f - q`` for a Gaussian f: the exact solution integrates
     f upstream (x > 0 side) with the decay length ``2 V tau_c``.  Measured on the medium
-    mesh to t = 10: 0.52 % (BDF2, dt = 0.02, the mesh's linear interpolation of the source
-    dominating), Euler 2.4 % and 1.3 % at dt = 0.04, 0.02 (first order)."""
+    mesh to t = 10: 0.90 % (BDF2, dt = 0.02: the source's linear interpolation and the film
+    points' defect, kept in place; 0.52 % without the defect, which the adaptive steps
+    need), Euler first order in dt."""
     from femehl.api import make_stepper
 
     st = make_stepper(dataclasses.replace(paper_sphere(), substrate=SLS), method="fe", mesh="medium")
@@ -74,7 +75,7 @@ def test_memory_is_carried_with_the_material():
         (s, dt): np.max(np.abs(_march_memory(st.memory, f, V, s, dt, 10.0) - exact)[inner]) / exact.max()
         for s, dt in [("bdf2", 0.02), ("euler", 0.04), ("euler", 0.02)]
     }
-    assert err["bdf2", 0.02] < 0.008
+    assert err["bdf2", 0.02] < 0.012
     assert 1.5 < err["euler", 0.04] / err["euler", 0.02] < 2.2  # first order in dt
     # at rest the memory relaxes in place: q -> dJ f (to the grid round trip, O(h^2))
     rest = _march_memory(st.memory, f, 0.0, "bdf2", 0.05, 30.0)
@@ -265,3 +266,13 @@ def test_line_toml_viscoelastic(tmp_path):
     f.write_text(src[:start] + half + src[end:])
     with pytest.raises(SceneFileError, match="Winkler"):
         load_scene_file(f)
+
+
+def test_adaptive_steps_reach_the_breakpoint():
+    """Adaptive steps (tol = 3e-3) land on the end of the indentation ramp (t = 1), where
+    they shrink to ~1e-4: the film points' memory continues without a jump at any step
+    size.  Before the film points kept their defect this run stopped at the step floor
+    (dt = 1.2e-6, error estimate 3.3e-3) on the fitted mesh; the coarse mesh shows it too."""
+    sc = dataclasses.replace(paper_sphere(), substrate=femehl.Viscoelastic(G0=1.0, G_inf=2 / 3, tau=0.3))
+    r = femehl.solve(sc, t_end=1.2, mesh="coarse", tol=3e-3, estimate=False)
+    assert r.t[-1] == pytest.approx(1.2) and np.min(r.dt[1:]) > 1e-5

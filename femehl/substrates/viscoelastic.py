@@ -72,6 +72,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
+from ..tribology import ENERGETICS_COLUMNS
 from ..validation import check_positive
 from .base import Substrate, register_substrate
 from .halfspace import HalfSpace
@@ -108,7 +109,7 @@ class Viscoelastic:
     elastic: object = field(default_factory=HalfSpace)
     kind = "viscoelastic"
     #: per-step figures of its runs (summary.csv, Result): the sliding energy budget
-    columns = ("friction", "dissipation_film", "power_sliding")
+    columns = ENERGETICS_COLUMNS
 
     def __post_init__(self):
         G0 = check_positive("unrelaxed modulus G0", self.G0, "Give G0 in units of G.")
@@ -309,11 +310,6 @@ class CreepMemory:
         a = np.asarray(state_array, dtype=float)
         m = self.grid.shape[0]
         return a[:m], a[m:]
-
-    def film_values(self, state_array):
-        """``q`` on the film points: the grid's spline there plus the carried defect."""
-        g, e = self.split(state_array)
-        return self._eval(self._spline(g), self.points, 0.0) + e
 
     # ---- the cubic spline of a grid field -------------------------------------------------
     def _spline(self, q):

@@ -1,8 +1,14 @@
 """Cavitation conditions: where the film cannot hold a pressure below ambient.
 
 Every femehl run without one is full Sommerfeld (the pressure may go below ambient).
-Two conditions are registered in :data:`CAVITATION_MODELS` (``Fluid(beta, cavitation=name)``,
+Three conditions are registered in :data:`CAVITATION_MODELS` (``Fluid(beta, cavitation=name)``,
 ``LineScene(cavitation=name)``, ``[fluid] cavitation = name``):
+
+``"jfo"`` (:class:`JFOCavitation`)
+    The mass-conserving model (Jakobsson-Floberg-Olsson, Elrod-Adams): ``p >= 0`` and the
+    film content ``theta`` carried through the cavity, rupture and reformation both
+    conserving the liquid.  Still ONE linear system per step: each node's unknown is its
+    pressure (full film) or its gas film (cavitated), the set lagged one step.
 
 ``"reynolds"`` (:class:`ReynoldsCavitation`)
     The Reynolds (Swift-Stieber) condition ``p >= 0``: the pressure is 0 on a cavitated
@@ -39,15 +45,19 @@ What each condition gets wrong:
   volume the condition supplies to the full-film balance: the liquid created where the
   film reforms, plus the cavity's gas growth and outflow (``info["full_film_source"]``,
   see :class:`ReynoldsCavitation`);
-* **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): the mass-conserving model, carrying
-  the film content in the cavitated region as an unknown; not in femehl yet.
+* **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): conserves the liquid everywhere; what
+  it leaves out is the physics of the cavity itself (gas dissolution, vapour pressure
+  below ambient: the cavity pressure is ambient, 0) and, in femehl's scheme, the content
+  is carried by a first-order upwind transport (its front smeared over a few elements)
+  and the full/cavitated set is lagged one step (see :class:`JFOCavitation`).
 
 A model is a class with ``name``, ``changes_step`` (False: post-processing only, so the
 paper's FD reference accepts it), ``clips_pressure`` (the pictures say "clipped"),
 ``columns`` (the summary.csv columns it adds, read from ``state.info``), ``note`` (how
 the reported fields are to be read), ``field_data`` (integer field data of the series),
-and the methods ``check_scene``, ``fixed``, ``lagged_pressure``, ``initial_info`` and
-``finish`` the stepper calls (:class:`femehl.core.stepper.LaggedStepper`).
+and the methods ``check_scene``, ``setup``, ``initial_info``, ``initial_state``,
+``lagged_pressure``, ``prepare`` (the step's system) and ``finish`` the stepper calls
+(:class:`femehl.core.stepper.LaggedStepper`), and ``point_fields`` the series writes.
 """
 
 from __future__ import annotations
@@ -100,6 +110,35 @@ class _Model:
         """Free-node indices held at p = 0 in the step after ``state`` (none by default)."""
         return np.zeros(0, dtype=np.int64)
 
+    def setup(self, disc) -> None:
+        """SceneError if the discretization cannot apply the condition; operators built once."""
+
+    def initial_state(self, state):
+        """The initial state with the condition's own fields (by default ``state``)."""
+        return state
+
+    def point_fields(self, disc, state) -> dict:
+        """Nodal fields the VTK series writes for the condition (every mesh node)."""
+        return {}
+
+    def prepare(self, stepper, op, rhs_list, state, ctx):
+        """The step's system: ``(operator, right-hand sides, aux)`` handed to the solver.
+
+        By default the rows :meth:`fixed` are held at ``p = 0``
+        (:meth:`~femehl.core.linsolve.StepOperator.with_fixed`) and ``aux`` is those rows.
+        A condition with unknowns of its own (JFO) returns a larger system whose solution
+        has them after the pressure; :meth:`finish` gets them as ``unknowns``.
+        """
+        fixed = self.fixed(state)
+        if fixed.size == 0:
+            return op, rhs_list, fixed
+        out = []
+        for b in rhs_list:
+            b = np.array(b, dtype=float)
+            b[fixed] = 0.0
+            out.append(b)
+        return op.with_fixed(fixed), out, fixed
+
     @staticmethod
     def lagged_pressure(state, free_index) -> np.ndarray:
         """The pressure unknowns of ``state`` the next step's lagged coefficients use."""
@@ -109,7 +148,7 @@ class _Model:
         """The columns' values at p = 0 (the initial state)."""
         return dict.fromkeys(self.columns, 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
         """The state the step returns, from the one built from the solved pressure.
 
         Parameters
@@ -124,11 +163,14 @@ class _Model:
             The solved pressure unknowns.
         new : femehl.stepping.State
             The state built from ``p`` (film, deflection, load, extremes).
-        fixed : ndarray of int
-            The rows held at ``p = 0`` in this step.
+        fixed : object
+            What :meth:`prepare` returned as ``aux`` (the rows held at ``p = 0``).
         scale : float, default: 1.0
             The factor ``op.G`` carries (a viscoelastic step's ``J_eff``): the terms' film
             operator is ``op.G / scale``.
+        unknowns : ndarray, optional
+            The condition's own unknowns, from the solution after the pressure (JFO: the
+            gas film); empty for the others.
 
         Returns
         -------
@@ -197,7 +239,7 @@ class ReynoldsCavitation(_Model):
             return np.zeros(0, dtype=np.int64)
         return np.flatnonzero(np.asarray(y) < 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
         """``p_aux = y``: ``p`` off the held set, ``-(A p - b)`` on it (the multiplier of the
         unmasked system): the next step's set is ``{y < 0}``; area, extremes and the mass
         source go to ``info``."""
@@ -263,7 +305,7 @@ class HalfSommerfeld(_Model):
         y = getattr(state, "p_aux", None)
         return np.asarray(state.p)[free_index] if y is None else np.asarray(y)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0):
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
         """Clip: ``p``, ``load``, ``p_max`` of ``max(p, 0)``; ``p_aux`` the full ``p``."""
         disc = stepper.disc
         clipped = np.maximum(p, 0.0)
@@ -283,13 +325,180 @@ class HalfSommerfeld(_Model):
         )
 
 
+@register_cavitation
+class JFOCavitation(_Model):
+    """Mass-conserving cavitation (Jakobsson-Floberg-Olsson, Elrod-Adams), one linear system per step.
+
+    **Model.**  The film holds liquid and gas: its liquid content is ``c = theta d``
+    (``0 <= theta <= 1`` the fractional filling), and the liquid is conserved everywhere,
+
+        dc/dt + div J = 0,      J = -beta d^3 grad p - V c e_x,
+        p >= 0,   theta <= 1,   p (1 - theta) = 0,
+
+    full film (``theta = 1``, Reynolds) where ``p > 0``, cavitated (``p = 0``, the content
+    carried by the sliding surface) where ``theta < 1``.  Flux continuity across a moving
+    rupture or reformation front is part of the conservation law: rupture and
+    reformation both conserve mass (the jump of ``theta`` at reformation is the JFO
+    condition).
+
+    **Unknowns.**  femehl writes the content as ``c = d - P v`` with ``v >= 0`` the *gas
+    film* (gas volume per unit area, P1 on the nodes, ``P`` the element average; ``d`` on
+    the elements as everywhere), so the content is linear in the unknowns and the step's
+    rows are those of the full film minus a sparse operator on ``v``
+    (:class:`femehl.discretizations._p1p0.GasTransport`)::
+
+        A p - B v = b - m (a1 v^k - a2 v^{k-1}) / dt,     B = V K - |V| D + (a0/dt) diag(m),
+
+    (``K`` the Galerkin Couette operator of a P1 field, ``D`` its discrete upwinding,
+    ``m`` the lumped mass: the gas is carried without new extrema).  At each node the
+    unknown is ``p`` (full) or ``v`` (cavitated): on the cavitated set ``S``, ``p = 0``
+    and ``v`` is solved for; off it ``v = 0``.  The step is ONE linear system
+    (:class:`femehl.core.linsolve.SwitchedOperator`), with the set lagged one step, like
+    every other coefficient.  After the solve ``y = p`` off ``S`` and ``y = -v`` on it
+    decide the next set, ``{y < 0}``: a full node whose pressure went negative ruptures, a
+    cavitated node whose gas went negative (more liquid arrived than the gap holds)
+    reforms.  The liquid is conserved by every step whatever the set (the rows are the
+    mass balance of the solved content, including at the nodes that change), so the set's
+    lag costs a one-step transient -- a pressure slightly below 0 at a node about to
+    rupture (``info["p_negative_min"]``) or a filling slightly above 1 at one about to
+    reform -- and never mass.
+
+    **Reported per step** (``state.info``, summary columns; whole-plane figures):
+    ``cavitated_area`` (``sum g_i`` over the next set), ``liquid_volume`` (the content
+    ``sum_q int phi_q c`` over the free nodes), ``net_outflow`` (the liquid leaving
+    through the rim minus the liquid entering, per unit time: the rows' flux part),
+    ``mass_imbalance`` (the step's discrete mass balance ``d(liquid_volume)/dt +
+    net_outflow`` by the scheme's own backward difference, relative to the size of its
+    terms: the solver's residual, ~1e-8), ``theta_min`` (the lowest filling ``1 - v/dbar``
+    at a cavitated node, ``dbar`` the mean gap of its cell; 1 without a cavity) and ``p_negative_min``.
+    ``state.gas`` is the gas film on the free nodes; the series writes ``gas_film`` and
+    ``film_content`` (``theta``) beside ``cavitated``.
+
+    Needs a P1 discretization (FE disks, line contact); the polar finite-difference
+    reference refuses it.  With no cavity the step is the full-Sommerfeld step (the
+    switched set empty), to the solver's tolerance.
+    """
+
+    name = "jfo"
+    columns = (
+        "cavitated_area",
+        "liquid_volume",
+        "net_outflow",
+        "mass_imbalance",
+        "theta_min",
+        "p_negative_min",
+    )
+    note = (
+        "JFO (Jakobsson-Floberg-Olsson / Elrod-Adams): mass-conserving cavitation; p >= 0 and the "
+        "film content theta carried through the cavity; rupture and reformation conserve mass; "
+        "the full/cavitated set lagged one step"
+    )
+
+    def setup(self, disc) -> None:
+        transport = getattr(disc, "gas_transport", None)
+        if transport is None:
+            raise SceneError(
+                f'cavitation="jfo" needs a P1 pressure and film content (method "fe" or "line"); '
+                f"the {getattr(disc, 'method', type(disc).__name__)!r} discretization has no "
+                'gas transport. Use method="fe" (the finite-element disk) or cavitation="reynolds".'
+            )
+        self.transport = transport()
+        self.squeeze = disc.squeeze()  # M[q, e] = int_e phi_q (free nodes x elements)
+        self.content_weight = np.asarray(self.squeeze.sum(axis=0)).ravel()  # sum_q int_e phi_q
+        self.plane = _plane_factor(disc)
+
+    def initial_state(self, state):
+        """No gas yet; the liquid volume is the whole gap's."""
+        info = dict(state.info)
+        info["liquid_volume"] = self.plane * float(self.content_weight @ state.d)
+        return dataclasses.replace(state, gas=np.zeros(self.transport.n), info=info)
+
+    def point_fields(self, disc, state) -> dict:
+        """``gas_film`` (``v``) and ``film_content`` (``theta = 1 - v/dbar``, 1 where full)."""
+        v = getattr(state, "gas", None)
+        if v is None:
+            return {}
+        dbar = (disc.squeeze() @ np.asarray(state.d)) / disc.node_weight[disc.free_index]
+        theta = 1.0 - np.asarray(v) / dbar
+        full = np.ones(disc.expand(v).size)
+        full[disc.free_index] = theta
+        return {"gas_film": disc.expand(v), "film_content": full}
+
+    def initial_info(self) -> dict:
+        info = dict.fromkeys(self.columns, 0.0)
+        info["theta_min"] = 1.0
+        return info
+
+    def prepare(self, stepper, op, rhs_list, state, ctx):
+        """The switched system: ``p`` or the gas ``v`` at each node, the set from ``state``."""
+        from .core.linsolve import SwitchedOperator
+
+        n = op.D.shape[0]
+        y = getattr(state, "p_aux", None)
+        switched = np.zeros(n, dtype=bool) if y is None else np.asarray(y) < 0.0
+        v = state.gas if state.gas is not None else np.zeros(n)
+        v_prev = state.gas_prev if state.gas_prev is not None else v
+        hist_v = ctx.a1 * v - ctx.a2 * v_prev
+        tr = self.transport
+        B = tr.operator(ctx.V, ctx.a0 / ctx.dt)
+        m = tr.mass
+        # the cavitated nodes' content carried upwind with their cell's mean gap (lagged film)
+        corr = tr.correction(ctx.V, switched, ctx.d_lag, (self.squeeze @ ctx.d_lag) / m)
+        zeros = np.zeros(n)
+        out = [np.concatenate([rhs_list[0] - m * hist_v / ctx.dt - corr, zeros])]
+        out += [np.concatenate([b, zeros]) for b in rhs_list[1:]]
+        aux = {"switched": switched, "B": B, "hist_v": hist_v, "ctx": ctx, "gas": v, "corr": corr}
+        return SwitchedOperator(op, B, switched), out, aux
+
+    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
+        """``p_aux = y`` (``p`` off the set, ``-v`` on it), ``gas = v``, the balance to ``info``."""
+        S = fixed["switched"]
+        ctx = fixed["ctx"]
+        v = np.where(S, np.asarray(unknowns, dtype=float), 0.0)
+        y = np.where(S, -v, p)
+        m, w = self.transport.mass, self.content_weight
+        d = new.d
+        # the content rows of the solved step: A p - B v - rhs + m hist_v / dt (~ 0)
+        poiseuille_etc = op.D @ p
+        film = (op.G @ d) / scale
+        res = poiseuille_etc + film - fixed["B"] @ v + fixed["corr"] - rhs + m * fixed["hist_v"] / ctx.dt
+        time_part = (w * (ctx.a0 * d - ctx.history)).sum() - (m * (ctx.a0 * v - fixed["hist_v"])).sum()
+        time_part /= ctx.dt
+        total = float(res.sum())
+        size = float(np.abs(poiseuille_etc).sum() + np.abs(film).sum() + np.abs(fixed["B"] @ v).sum())
+        size += float(np.abs(fixed["corr"]).sum())
+        info = dict(new.info)
+        f = self.plane
+        info["cavitated_area"] = float(stepper.g[y < 0.0].sum())
+        info["liquid_volume"] = f * float(w @ d - m @ v)
+        info["net_outflow"] = f * (total - time_part)
+        info["mass_imbalance"] = abs(total) / size if size > 0.0 else 0.0
+        free = ~S
+        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
+        theta = 1.0
+        if S.any():  # 1 - v / dbar, dbar the mean gap of the node's cell (its row's content)
+            dbar = (self.squeeze @ d) / m
+            theta = float(np.min(1.0 - v[S] / dbar[S]))
+        info["theta_min"] = theta
+        return dataclasses.replace(new, info=info, p_aux=y, gas=v, gas_prev=fixed["gas"])
+
+
 def _plane_factor(disc) -> float:
     """2 for a half disk (its rows integrate over y >= 0), else 1: whole-plane figures."""
     return 2.0 if getattr(disc, "half", False) else 1.0
 
 
 #: every column a cavitation model may add to summary.csv, in a fixed order
-CAVITATION_COLUMNS = ("load_full", "cavitated_area", "full_film_source")
+CAVITATION_COLUMNS = (
+    "load_full",
+    "cavitated_area",
+    "full_film_source",
+    "liquid_volume",
+    "net_outflow",
+    "mass_imbalance",
+    "theta_min",
+    "p_negative_min",
+)
 
 
 def cavitation_model(name):

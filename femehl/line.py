@@ -16,7 +16,7 @@ obeys the 1-D normalized Reynolds equation, with the same conventions as the
 The cylinder slides toward +x; in its frame the substrate moves toward -x,
 so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
 gap, hc < 0 an indentation.  Without a cavitation condition (full Sommerfeld) p may
-go negative (at the exit), as in the 2-D solvers; ``cavitation="reynolds"`` or
+go negative (at the exit), as in the 2-D solvers; ``cavitation="jfo"``, ``"reynolds"`` or
 ``"half-sommerfeld"`` as there (:mod:`femehl.cavitation`).  The paper checks its scheme on this
 problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
 steady sliding solution, which :mod:`femehl.line_steady` computes by
@@ -109,7 +109,7 @@ class LineScene(SceneEffects):
         instead.  ``motion.load`` is accepted too (and moved here); give one of them.
     viscosity : femehl.Barus or femehl.Roelands, optional
         Pressure-dependent viscosity (:mod:`femehl.viscosity`); None: isoviscous.
-    cavitation : {None, "reynolds", "half-sommerfeld"}, optional
+    cavitation : {None, "jfo", "reynolds", "half-sommerfeld"}, optional
         Cavitation condition (:mod:`femehl.cavitation`); None: full Sommerfeld.
     viscoelastic : femehl.Viscoelastic, optional
         A viscoelastic foundation: the standard linear solid whose relaxed stiffness is

@@ -229,6 +229,7 @@ class Fluid:
     ``viscosity``: None (isoviscous, the paper's) or a pressure-viscosity model,
     :class:`femehl.Barus` or :class:`femehl.Roelands` (:mod:`femehl.viscosity`), lagged one
     step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's),
+    ``"jfo"`` (mass-conserving: the film content carried through the cavity),
     ``"reynolds"`` (``p >= 0``) or ``"half-sommerfeld"`` (the full-Sommerfeld run with its
     negative pressures clipped in what is reported), see :mod:`femehl.cavitation`.
     """

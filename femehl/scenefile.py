@@ -12,7 +12,8 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           | "layer" (thickness, nu, bonded): an elastic layer on a
                           rigid base, thickness in the units of x and y
     [fluid]               beta = 200.0
-                          cavitation = "reynolds" (optional: p >= 0) | "half-sommerfeld"
+                          cavitation = "jfo" (optional: mass-conserving) | "reynolds"
+                          (p >= 0) | "half-sommerfeld"
                           (negative pressures clipped after the full-Sommerfeld
                           step; imposed gap only); default full Sommerfeld
     [fluid.viscosity]     optional: kind = "barus" (alpha) | "roelands" (alpha, p_r, Z),

@@ -63,6 +63,8 @@ class State:
     p_aux: np.ndarray | None = None  # cavitation: p off the cavitated set, -multiplier on it
     creep: np.ndarray | None = None  # viscoelastic substrate: delayed deflection q on the film points
     creep_prev: np.ndarray | None = None  # q one step earlier (two-step schemes)
+    gas: np.ndarray | None = None  # JFO cavitation: gas film v on the pressure unknowns (0 where full)
+    gas_prev: np.ndarray | None = None  # v one step earlier (two-step schemes)
 
 
 class Stepper(Protocol):

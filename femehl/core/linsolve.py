@@ -58,6 +58,7 @@ from ..errors import SceneError, SingularSystemError
 
 __all__ = [
     "StepOperator",
+    "SwitchedOperator",
     "LINEAR_SOLVERS",
     "register_linear_solver",
     "DirectSolver",
@@ -145,6 +146,17 @@ class StepOperator:
         G = self.G if G is None else G
         return self.D @ Z + G @ CZ
 
+    def columns(self, idx, dtype=np.float64) -> np.ndarray:
+        """The dense columns ``A[:, idx]`` (n x len(idx)) of a dense operator."""
+        out = self.D[:, idx].toarray().astype(dtype)
+        for c, _, FC in self.films:
+            out += c * FC[:, idx]
+        return out
+
+    def factorize(self, dtype, t):
+        """An LU of the dense ``A`` with ``.solve(b)`` (``A x = b``), in ``dtype``."""
+        return DenseLU(self.matrix(dtype=dtype), t)
+
     def with_fixed(self, fixed) -> StepOperator:
         """The operator with the rows ``fixed`` replaced by identity rows (``x_i = b_i``).
 
@@ -177,6 +189,174 @@ class _RowMasked:
 
     def __getitem__(self, rows):
         return self.FC[rows] * self.keep[rows, None]
+
+
+class SwitchedOperator:
+    """A step whose unknown ``j`` is ``p_j``, or on the switched set ``S`` an auxiliary ``v_j``.
+
+    The system of ``2n`` unknowns ``(p, v)`` (a mass-conserving cavitation step,
+    :class:`femehl.cavitation.JFOCavitation`: ``v`` the gas film)::
+
+        [ A      -B P_S ] [p]   [b]
+        [ E_S     E_F   ] [v] = [0]      (p_j = 0 on S, v_j = 0 off it)
+
+    with ``A`` the :class:`StepOperator` ``base`` and ``B`` sparse.  Only ``A`` holds the
+    dense (or hierarchical) compliance, and it acts on ``p`` alone: ``C`` of this operator
+    is ``base.C`` reading the first ``n`` entries, so the recycled ``(z, C z)`` of the
+    Krylov solver stay valid whatever ``S`` was when they were made.  Its direct solve
+    is one LU of the ``n x n`` matrix ``M = A P_F - B P_S`` (the columns of ``S`` replaced
+    by those of ``-B``), :class:`SwitchedLU`; a sparse ``C`` (Winkler, rigid) gives a
+    sparse ``2n x 2n`` matrix, the fast operator a sparse ``near_matrix``.
+    """
+
+    def __init__(self, base: StepOperator, B, switched):
+        self.base = base
+        self.B = sp.csr_matrix(B)
+        self.switched = np.asarray(switched, dtype=bool)
+        self.n = n = base.D.shape[0]
+        self.key = base.key
+        self.C = _Leading(base.C, n)
+        on = self.switched.astype(float)
+        self._blocks = (-self.B @ sp.diags(on), sp.diags(on), sp.diags(1.0 - on))
+
+    @property
+    def dense(self) -> bool:
+        return self.base.dense
+
+    @property
+    def fast(self) -> bool:
+        return self.base.fast
+
+    def _stack(self, A):
+        mBS, ES, EF = self._blocks
+        return sp.bmat([[A, mBS], [ES, EF]], format="csr")
+
+    @cached_property
+    def D(self):
+        return self._stack(self.base.D)
+
+    @cached_property
+    def G(self):
+        G = self.base.G
+        return sp.vstack([G, sp.csr_matrix((self.n, G.shape[1]))], format="csr")
+
+    def apply(self, Z, CZ, G=None):
+        G = self.G if G is None else G
+        return self.D @ Z + G @ CZ
+
+    def near_matrix(self):
+        return sp.csc_matrix(self._stack(self.base.near_matrix()))
+
+    def matrix(self, dtype=np.float64):
+        """The sparse ``2n x 2n`` matrix (a sparse ``C``); a dense one is never formed."""
+        if self.dense or self.fast:
+            raise SceneError("a switched dense step is solved through factorize(), not matrix().")
+        return sp.csc_matrix(self._stack(self.base.matrix()))
+
+    def factorize(self, dtype, t):
+        return SwitchedLU(self, dtype, t)
+
+    def columns_M(self, idx, dtype):
+        """Columns ``idx`` of ``M = A P_F - B P_S`` (dense)."""
+        out = self.base.columns(idx, dtype)
+        on = self.switched[idx]
+        if on.any():
+            out[:, on] = -self.B[:, idx[on]].toarray()
+        return out
+
+
+class _Leading:
+    """``C`` acting on the first ``n`` entries of a ``2n`` vector (or of its columns)."""
+
+    def __init__(self, C, n):
+        self.C, self.n = C, n
+        self.shape = (C.shape[0], 2 * n)
+
+    def __matmul__(self, z):
+        return self.C @ z[: self.n]
+
+
+class DenseLU:
+    """LAPACK LU of a dense, C-ordered ``A`` (factored as ``A^T``, no copy): ``solve(b)``."""
+
+    def __init__(self, A, t):
+        self.lu = _dense_lu(A, t)
+        self.dtype = A.dtype
+
+    def solve(self, b):
+        lu = self.lu
+        return sla.lu_solve(lu, b.astype(lu[0].dtype, copy=False), trans=1, check_finite=False).astype(
+            np.float64, copy=False
+        )
+
+
+class SwitchedLU:
+    """LU of ``M = A P_F - B P_S`` of a :class:`SwitchedOperator`, reused as the set moves.
+
+    ``solve([r1; r2])`` solves the switched system: ``p_S = r2_S``, ``v_F = r2_F`` and
+    ``M y = r1 - D[:, S] r2_S`` for ``y = (p_F, v_S)`` (the ``G C`` part of the coupling
+    ``A[:, S] r2_S`` is left out: exact when ``r2_S = 0``, as for every right-hand side of
+    a step, and a preconditioner otherwise).  :meth:`adapt` updates it to a later step
+    whose set differs in ``k`` nodes by a rank-``k`` Woodbury correction (the changed
+    columns, taken from the later step's operator), so the preconditioner stays exact in
+    the switched columns while the cavity's edge moves; beyond ``max_changes`` it asks
+    for a new factorization.
+    """
+
+    max_changes = 64
+
+    def __init__(self, op: SwitchedOperator, dtype, t):
+        n = op.n
+        S = np.flatnonzero(op.switched)
+        A = op.base.matrix(dtype=dtype)
+        if S.size:
+            A[:, S] = -op.B[:, S].toarray()
+        self.lu = DenseLU(A, t)
+        self.switched = op.switched.copy()
+        self.n = n
+        self.op = op
+        self._corr = None
+
+    def adapt(self, op: SwitchedOperator) -> bool:
+        """Use this factor for ``op``; False when its set changed too much (refactor)."""
+        self.op = op
+        delta = np.flatnonzero(op.switched != self.switched)
+        if delta.size == 0:
+            self._corr = None
+            return True
+        if delta.size > self.max_changes:
+            return False
+        # M_now[:, j] - M_factor[:, j] on the changed columns: +-(A[:, j] + B[:, j])
+        sign = np.where(op.switched[delta], -1.0, 1.0)
+        U = (op.base.columns(delta) + op.B[:, delta].toarray()) * sign
+        Z = self.lu.solve(U)
+        small = np.eye(delta.size) + Z[delta]
+        try:
+            small_lu = sla.lu_factor(small, check_finite=True)
+        except (ValueError, np.linalg.LinAlgError):
+            return False
+        self._corr = (delta, Z, small_lu)
+        return True
+
+    def _solve_M(self, r):
+        y = self.lu.solve(r)
+        if self._corr is not None:
+            delta, Z, small_lu = self._corr
+            y = y - Z @ sla.lu_solve(small_lu, y[delta])
+        return y
+
+    def solve(self, b):
+        n, op = self.n, self.op
+        S = op.switched
+        r1, r2 = b[:n], b[n:]
+        rhs = r1
+        if np.any(r2[S]):
+            rhs = r1 - op.base.D[:, S] @ r2[S]
+        y = self._solve_M(rhs)
+        x = np.empty(2 * n)
+        x[:n] = np.where(S, r2, y)
+        x[n:] = np.where(S, y, r2)
+        return x
 
 
 #: name -> linear solver class
@@ -268,10 +448,7 @@ class DirectSolver:
     def factor(self, op: StepOperator, t: float):
         t0 = time.perf_counter()
         if op.dense:
-            lu = _dense_lu(op.matrix(), t)
-
-            def solve(b):
-                return sla.lu_solve(lu, b, trans=1)
+            solve = op.factorize(np.float64, t).solve
         else:
             A = op.matrix()
             lu = _sparse_lu(A, t)
@@ -301,7 +478,7 @@ class DirectSolver:
 
 @dataclass
 class _Factor:
-    lu: tuple  # LAPACK LU of A^T (A C-ordered = A^T Fortran-ordered: no copy)
+    lu: object  # the preconditioner: DenseLU, SwitchedLU or PermutedLU (``.solve(r)``)
     key: float  # op.key of the factorized matrix
     total: float  # cost of this factor's cycle: factorization + preconditioned iterations
     solves: int = 0  # solves of this cycle
@@ -390,6 +567,8 @@ class RecycledGCR:
             return np.zeros_like(b), None
         f = self.factor
         fresh = f is None or f.stale or abs(f.key - op.key) > 0.1 * op.key
+        if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
+            fresh = not f.lu.adapt(op)
         if fresh:
             f = self._refactor(op, t)
         t0 = time.perf_counter()
@@ -444,7 +623,7 @@ class RecycledGCR:
                 self._order = ((A.shape, A.nnz), nested_dissection(A))
             lu = PermutedLU(A, self._order[1], t)
         else:
-            lu = _dense_lu(op.matrix(dtype=self.precond_dtype), t)
+            lu = op.factorize(self.precond_dtype, t)
         cost = time.perf_counter() - t0
         self._own_factorizations += 1
         self._own_factor_s += cost
@@ -453,12 +632,7 @@ class RecycledGCR:
         return self.factor
 
     def _precondition(self, r):
-        lu = self.factor.lu
-        if isinstance(lu, PermutedLU):
-            return lu.solve(r)
-        return sla.lu_solve(lu, r.astype(lu[0].dtype, copy=False), trans=1, check_finite=False).astype(
-            np.float64, copy=False
-        )
+        return self.factor.lu.solve(r)
 
     def _krylov(self, op, G, b, bnorm, f):
         """Minimal residual over recycled + preconditioned directions.

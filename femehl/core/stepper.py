@@ -120,6 +120,7 @@ class LaggedStepper:
         self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
         if self.cavitation is not None:
             self.cavitation.check_scene(scene)
+            self.cavitation.setup(disc)
         memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
         self.memory = None if memory is None else memory(disc)
         from ..output.table import extra_columns
@@ -286,6 +287,8 @@ class LaggedStepper:
         state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
         if self.memory is not None:  # the material at rest, unloaded
             state = dataclasses.replace(state, creep=np.zeros(self.memory.size))
+        if self.cavitation is not None:  # a condition's own fields (JFO: no gas yet)
+            state = self.cavitation.initial_state(state)
         self._budget(state)
         return state
 
@@ -314,7 +317,17 @@ class LaggedStepper:
         p_old = state.p[free_index] if cav is None else cav.lagged_pressure(state, free_index)
         its0 = self.solver.info.get("krylov_iterations", 0)
         ctx = StepContext(
-            t_new=t_new, dt=dt, a0=a0, d=state.d, d_lag=d_lag, history=hist, p=p_old, V=V, beta=self.beta
+            t_new=t_new,
+            dt=dt,
+            a0=a0,
+            d=state.d,
+            d_lag=d_lag,
+            history=hist,
+            p=p_old,
+            V=V,
+            beta=self.beta,
+            a1=a1,
+            a2=a2,
         )
         mem = None
         if self.memory is not None:  # viscoelastic: d = h + offset + J_eff C p
@@ -322,18 +335,21 @@ class LaggedStepper:
         scale = 1.0 if mem is None else mem.scale
         shape = self.shape if mem is None else self.shape + mem.offset
         op, rhs = self.operator(ctx, scale)
-        full, rhs_full = op, rhs
-        fixed = cav.fixed(state) if cav is not None else np.zeros(0, dtype=np.int64)
-        if fixed.size:  # cavitated nodes: p = 0 rows, the set from the previous step
-            op = op.with_fixed(fixed)
-            rhs = rhs.copy()
-            rhs[fixed] = 0.0
         G = op.G if mem is None else op.G / scale  # the terms' G (op.G carries the scale)
         hc_dot = None
+        ones = np.ones(self.shape.size)
         if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
-            ones = np.ones(self.shape.size)
-            (x1, cx1), (x2, cx2) = self.solver.solve(op, [rhs - G @ shape, G @ ones], t_new)
-            g1, g2 = float(self.g @ x1), float(self.g @ x2)
+            rhs_list = [rhs - G @ shape, G @ ones]
+        else:
+            hc = mo.hc(t_new)
+            rhs_list = [rhs - G @ (hc + shape)]
+        system, aux = op, None
+        if cav is not None:  # the condition's system: held rows, or more unknowns
+            system, rhs_list, aux = cav.prepare(self, op, rhs_list, state, ctx)
+        if mo.solves_hc:
+            (x1, cx1), (x2, cx2) = self.solver.solve(system, rhs_list, t_new)
+            n = self.disc.n  # a condition's own unknowns follow the pressure
+            g1, g2 = float(self.g @ x1[:n]), float(self.g @ x2[:n])
             if mo.free:
                 hc, hc_dot = self._newton_row(state, t_new, dt, g1, g2, a0, a1, a2)
             else:  # the load row: g . p = F
@@ -344,11 +360,11 @@ class LaggedStepper:
                         t=t_new,
                     )
                 hc = (g1 - mo.F(t_new)) / g2
-            p = x1 - hc * x2
+            x = x1 - hc * x2
             Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
         else:
-            hc = mo.hc(t_new)
-            ((p, Cp),) = self.solver.solve(op, [rhs - G @ (hc + shape)], t_new)
+            ((x, Cp),) = self.solver.solve(system, rhs_list, t_new)
+        p, unknowns = x[: self.disc.n], x[self.disc.n :]
         if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
@@ -372,7 +388,7 @@ class LaggedStepper:
         if extra:
             new = dataclasses.replace(new, **extra)
         if cav is not None:  # the condition's part after the solve (unmasked system)
-            new = cav.finish(self, full, rhs_full, p, new, fixed, scale)
+            new = cav.finish(self, op, rhs, p, new, aux, scale, unknowns)
         return new
 
     def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):

@@ -51,7 +51,7 @@ class StepContext:
     """What a term may use to contribute to the step from ``t`` to ``t_new``.
 
     ``d`` is the film at step k, ``d_lag`` the scheme's lagged film ``d^*``, ``history``
-    ``a1 d^k - a2 d^{k-1}``; ``a0`` the scheme's leading coefficient; ``p`` the pressure
+    ``a1 d^k - a2 d^{k-1}``; ``a0, a1, a2`` the scheme's coefficients; ``p`` the pressure
     unknowns at step k; ``V`` the sliding velocity at ``t_new``.
     """
 
@@ -64,6 +64,8 @@ class StepContext:
     p: np.ndarray
     V: float
     beta: float
+    a1: float = 1.0
+    a2: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,114 @@ from skfem import asm
 
 from ..fe.forms import couette, film_diffusion, squeeze
 
-__all__ = ["P1P0"]
+__all__ = ["P1P0", "GasTransport"]
+
+
+class GasTransport:
+    """Row operators of a P1 nodal gas film ``v`` (volume per area) on the free nodes (JFO).
+
+    In the film's mass balance the liquid content is ``c = d - v`` (``d`` the gap on the
+    elements, ``v`` the gas in it, :class:`femehl.cavitation.JFOCavitation`).  The Couette
+    row of the content is written element by element as fluxes between the element's
+    node pairs, ``F_ij = V (b_i c_j - b_j c_i)/nv - delta_ij (c_j - c_i)`` with
+    ``b_i = int_e dphi_i/dx`` and the node values ``c_k`` of the content in that element
+    (antisymmetric in ``i, j``: the liquid is conserved).  With ``c_k = d_e`` (a full
+    film) the diffusion vanishes and ``F`` is the Galerkin Couette term of the P0 film,
+    unchanged; ``delta_ij = max(0, V b_i, V b_j)/nv`` is the element's discrete upwinding
+    (Kuzmin's low-order flux), which makes the content's transport monotone.  On a
+    cavitated node inside the cavity (no full neighbour) ``c_k = dbar_k - v_k``, ``dbar_k =
+    (M d)_k / m_k`` the mean gap of the node's cell (``m_k = int phi_k``, so ``m_k c_k`` is
+    exactly the content the node's row holds): the content, not only the gas, is carried
+    upwind, so it stays >= 0 however the gap varies from element to element.  On the
+    cavity's first row of nodes (beside a full node) ``c_k = d_e - v_k``.
+
+    That splits into (i) the P0 Couette row of ``d`` (the full film's, unchanged), (ii)
+    ``-B v`` with
+
+        B(V, c0) = V K - |V| D_sign(V) + c0 diag(m),        c0 = a0/dt,
+
+    ``K = Bx P`` the Galerkin Couette operator of a P1 field and ``D`` the assembled
+    element upwinding (symmetric, zero row sums: an M-matrix ``B``), and (iii) a
+    correction of the cavitated nodes' gap from ``d_e`` to ``dbar_k``
+    (:meth:`correction`), taken at the step's lagged film: sparse, explicit, and in flux
+    form, so it changes no conservation.
+    """
+
+    def __init__(self, elements, b, mass, free, n):
+        self.t = elements  # (nv, ne) node indices
+        self.b = b  # (nv, ne) int_e dphi/dx
+        self.nv = elements.shape[0]
+        self.mass = mass  # (n,) int phi_q on the free nodes
+        self.free = free
+        self.n = n
+        nn = int(elements.max()) + 1
+        self.slot = np.full(nn, -1, dtype=np.int64)  # node -> free index, -1 on the rim
+        self.slot[free] = np.arange(free.size)
+        ne = b.shape[1]
+        nodes, elems = elements.ravel(), np.tile(np.arange(ne), self.nv)
+        X = sp.csr_matrix((b.ravel(), (nodes, elems)), shape=(nn, ne))  # int_e dphi/dx
+        P = sp.csr_matrix((np.full(b.size, 1.0 / self.nv), (elems, nodes)), shape=(ne, nn))
+        K = (X @ P).tocsr()
+        self.K = K[free][:, free].tocsr()
+        self.upwind = {s: self._element_upwinding(s)[free][:, free].tocsr() for s in (1, -1)}
+        A = (abs(self._element_upwinding(1)) + abs(self._element_upwinding(-1))).tocsr()
+        self.neighbours = (A[free][:, free] != 0).astype(np.int64).tocsr()  # free-node graph
+
+    def _pairs(self, sign):
+        """``delta_ij`` for unit ``|V|`` of each element's node pairs, (nv, nv, ne)."""
+        sb = sign * self.b / self.nv
+        dl = np.maximum(0.0, np.maximum(sb[:, None, :], sb[None, :, :]))
+        idx = np.arange(self.nv)
+        dl[idx, idx, :] = 0.0
+        return dl
+
+    def _element_upwinding(self, sign):
+        dl = self._pairs(sign)
+        t = self.t
+        nn = self.slot.size
+        rows = np.broadcast_to(t[:, None, :], dl.shape).ravel()
+        cols = np.broadcast_to(t[None, :, :], dl.shape).ravel()
+        Dd = sp.csr_matrix((dl.ravel(), (rows, cols)), shape=(nn, nn))
+        return (Dd - sp.diags(np.asarray(Dd.sum(axis=1)).ravel())).tocsr()
+
+    def operator(self, V: float, c0: float):
+        """``B(V, c0)`` (sparse CSR, free nodes x free nodes)."""
+        B = sp.diags(c0 * self.mass)
+        if V != 0.0:
+            B = B + V * self.K - abs(V) * self.upwind[1 if V > 0 else -1]
+        return B.tocsr()
+
+    def correction(self, V: float, switched, d, dbar):
+        """The rows' flux change when the cavitated nodes' gap is ``dbar_k``, not ``d_e``.
+
+        ``switched`` (bool, free nodes) the cavitated set, ``d`` the element film and
+        ``dbar`` the nodal cell means (free nodes) it is taken from.  Returns the rows'
+        change (free nodes); its sum is 0 up to the rim's rows (flux form).
+        """
+        out = np.zeros(self.n)
+        if V == 0.0 or not np.any(switched):
+            return out
+        switched = np.asarray(switched, dtype=bool)
+        # only inside the cavity: a node beside a full one keeps d_e (the rupture front's
+        # rows stay those of the gas alone, whose lagged set then settles)
+        interior = switched & (self.neighbours @ (~switched).astype(np.int64) == 0)
+        k = self.slot[self.t]  # (nv, ne) free index or -1
+        on = np.zeros(k.shape, dtype=bool)
+        inside = k >= 0
+        on[inside] = interior[k[inside]]
+        if not on.any():
+            return out
+        delta = np.zeros(k.shape)
+        delta[on] = np.asarray(dbar)[k[on]] - np.broadcast_to(d, k.shape)[on]
+        e = np.flatnonzero(on.any(axis=0))  # the elements that touch the set
+        b, D, dl = self.b[:, e], delta[:, e], abs(V) * self._pairs(1 if V > 0 else -1)[:, :, e]
+        # F_ij = V (b_i D_j - b_j D_i)/nv - dl_ij (D_j - D_i), summed over j
+        F = V * (b * D.sum(axis=0) - D * b.sum(axis=0)) / self.nv
+        F -= np.einsum("ije,je->ie", dl, D) - dl.sum(axis=1) * D
+        rows = k[:, e]
+        ok = rows >= 0
+        np.add.at(out, rows[ok], F[ok])
+        return out
 
 
 class P1P0:
@@ -78,6 +185,22 @@ class P1P0:
     def average(self):
         """The element average of the P1 pressure (elements x free nodes)."""
         return self.P[:, self.free]
+
+    def gas_transport(self):
+        """The operators of a P1 gas film carried by the sliding surface (JFO cavitation).
+
+        Built once, see :class:`GasTransport`: the Galerkin Couette operator of a P1 field
+        ``K = Bx P`` (``K[q, j] = int phi_j dq/dx``, exactly what the Couette term does to the
+        element average), its discrete-upwind diffusion for either sign of V, and the
+        lumped mass ``int phi_q`` of the free nodes.
+        """
+        if getattr(self, "_gas", None) is None:
+            X = asm(couette, self.basis0, self.basis).tocsr()  # int_e dphi_q/dx, every node
+            t = self.basis.mesh.t
+            cols = np.tile(np.arange(t.shape[1]), t.shape[0])
+            b = np.asarray(X[t.ravel(), cols]).ravel().reshape(t.shape)
+            self._gas = GasTransport(t, b, self.node_weight[self.free].copy(), self.free, self.n)
+        return self._gas
 
     # ---- fields for results (``pressure_rows`` and ``_cell_value`` are the mesh's) -----
     def pressure_at(self, p, points):

@@ -91,7 +91,7 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
     arrays["p_aux"] = np.zeros(0) if state.p_aux is None else np.asarray(state.p_aux, dtype=float)
-    for k in ("creep", "creep_prev"):  # a viscoelastic substrate's internal variable
+    for k in _INTERNAL:  # a viscoelastic substrate's memory, a JFO film's gas
         v = getattr(state, k)
         arrays[k] = np.zeros(0) if v is None else np.asarray(v, dtype=float)
     for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
@@ -183,12 +183,15 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         hc_prev=_optional(a, "hc_prev", path),
         hc_dot_prev=_optional(a, "hc_dot_prev", path),
         p_aux=np.asarray(a["p_aux"], dtype=float) if "p_aux" in a and a["p_aux"].size else None,
-        creep=_optional_array(a, "creep"),  # a viscoelastic substrate's internal variable
-        creep_prev=_optional_array(a, "creep_prev"),
+        **{k: _optional_array(a, k) for k in _INTERNAL},  # absent from older checkpoints
     )
     if reference is not None:
         check_state(state, reference, path)
     return state
+
+
+#: internal variables of a state (None when the run has none): viscoelastic memory, JFO gas
+_INTERNAL = ("creep", "creep_prev", "gas", "gas_prev")
 
 
 def _optional_array(a, key):
@@ -210,14 +213,16 @@ def check_state(state: State, reference: State, path="checkpoint") -> None:
             f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
             f"the discretization needs {np.shape(reference.d)}",
         )
-    for k in ("creep", "creep_prev"):
+    for k in _INTERNAL:
         v = getattr(state, k)
-        want = np.shape(reference.creep) if reference.creep is not None else None
+        ref = getattr(reference, k.removesuffix("_prev"))
+        want = np.shape(ref) if ref is not None else None
         if v is not None and (np.shape(v) != want or not np.all(np.isfinite(v))):
+            what = "viscoelastic memory" if k.startswith("creep") else "JFO gas film"
             raise _bad(
                 path,
                 f"its array {k!r} has shape {np.shape(v)} or non-finite values; the "
-                f"discretization's viscoelastic memory needs {want} finite values",
+                f"discretization's {what} needs {want} finite values",
             )
 
 

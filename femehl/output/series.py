@@ -94,6 +94,9 @@ class SeriesWriter:
         cav = cavitated_nodes(self.disc, state)
         if cav is not None:  # a run with a cavitation condition: 1 where p is held at 0
             point_data["cavitated"] = cav[self._source] if self.mirrored else cav
+        if self.cavitation is not None:  # the condition's own nodal fields (JFO: gas, theta)
+            for k, v in self.cavitation.point_fields(self.disc, state).items():
+                point_data[k] = v[self._source] if self.mirrored else v
         mesh = meshio.Mesh(
             self.points,
             self.cells,

@@ -354,10 +354,15 @@ class JFOCavitation(_Model):
     unknown is ``p`` (full) or ``v`` (cavitated): on the cavitated set ``S``, ``p = 0``
     and ``v`` is solved for; off it ``v = 0``.  The step is ONE linear system
     (:class:`femehl.core.linsolve.SwitchedOperator`), with the set lagged one step, like
-    every other coefficient.  After the solve ``y = p`` off ``S`` and ``y = -v`` on it
-    decide the next set, ``{y < 0}``: a full node whose pressure went negative ruptures, a
-    cavitated node whose gas went negative (more liquid arrived than the gap holds)
-    reforms.  The liquid is conserved by every step whatever the set (the rows are the
+    every other coefficient.  After the solve ``y = p`` off ``S`` and ``y = -(v + tol
+    dbar)`` on it decide the next set, ``{y < 0}`` (``state.p_aux``): a full node whose
+    pressure went negative ruptures, a cavitated node whose gas went negative beyond
+    ``tol dbar`` (more liquid arrived than its cell's gap ``dbar`` holds, filling above
+    ``1 + tol``, :attr:`REFORM_TOL` ``= 1e-3``) reforms.  The margin damps the switching
+    of a node on the cavity's edge, where both ``p`` and ``v`` are about 0 (a period-2
+    cycle of the lagged set on the paper case's fine mesh with a margin of 0, every 3 to 5
+    steps with it, its negative pressure <= 5e-4 of the peak); it bounds the overfill of
+    a cavitated node, which the liquid balance still counts.  The liquid is conserved by every step whatever the set (the rows are the
     mass balance of the solved content, including at the nodes that change), so the set's
     lag costs a one-step transient -- a pressure slightly below 0 at a node about to
     rupture (``info["p_negative_min"]``) or a filling slightly above 1 at one about to
@@ -380,6 +385,8 @@ class JFOCavitation(_Model):
     """
 
     name = "jfo"
+    #: a cavitated node reforms when its filling exceeds 1 by more than this
+    REFORM_TOL = 1e-3
     columns = (
         "cavitated_area",
         "liquid_volume",
@@ -455,9 +462,12 @@ class JFOCavitation(_Model):
         S = fixed["switched"]
         ctx = fixed["ctx"]
         v = np.where(S, np.asarray(unknowns, dtype=float), 0.0)
-        y = np.where(S, -v, p)
         m, w = self.transport.mass, self.content_weight
         d = new.d
+        dbar = (self.squeeze @ d) / m  # the mean gap of each node's cell
+        # the next set: full nodes whose pressure went negative, and the cavitated nodes
+        # unless overfilled beyond REFORM_TOL (theta > 1 + REFORM_TOL: the film reforms)
+        y = np.where(S, -(v + self.REFORM_TOL * dbar), p)
         # the content rows of the solved step: A p - B v - rhs + m hist_v / dt (~ 0)
         poiseuille_etc = op.D @ p
         film = (op.G @ d) / scale
@@ -477,7 +487,6 @@ class JFOCavitation(_Model):
         info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
         theta = 1.0
         if S.any():  # 1 - v / dbar, dbar the mean gap of the node's cell (its row's content)
-            dbar = (self.squeeze @ d) / m
             theta = float(np.min(1.0 - v[S] / dbar[S]))
         info["theta_min"] = theta
         return dataclasses.replace(new, info=info, p_aux=y, gas=v, gas_prev=fixed["gas"])

@@ -369,7 +369,7 @@ class _Problem:
         return h if self.rigid else h + np.asarray(p) / self.k
 
     def _h1(self, x):
-        return self.hc + float(self._s(np.array([x]))[0])
+        return self.hc + float(self.profile(np.array([x]))[0])
 
     def integrate(self, q, x0, x1, rtol=None, stop=None, dense=False):
         """(5) from x0 (p = 0) toward x1 > x0 with flux film q.
@@ -466,17 +466,24 @@ def _root(fun, a, b, rtol, scale):
     are few (brentq's interpolation converges in a handful of steps on a smooth miss).
     """
     v0 = brentq(lambda v: fun(v, _SCAN_RTOL), a, b, xtol=1e-10 * scale, rtol=1e-12, maxiter=200)
-    fa, fb = fun(a, rtol), fun(b, rtol)
+    memo = {}
+
+    def tight(v):
+        if v not in memo:
+            memo[v] = fun(v, rtol)
+        return memo[v]
+
     delta = 1e-6 * scale
-    while delta < (b - a):
+    while True:
         lo, hi = max(a, v0 - delta), min(b, v0 + delta)
-        flo = fa if lo == a else fun(lo, rtol)
-        fhi = fb if hi == b else fun(hi, rtol)
-        if (flo > 0.0) != (fhi > 0.0):
-            a, b = lo, hi
+        if (tight(lo) > 0.0) != (tight(hi) > 0.0):
             break
+        if lo == a and hi == b:
+            raise SolverError(
+                f"steady_jfo: the root in [{a:.6g}, {b:.6g}] is lost at rtol = {rtol:g}; try method='Radau'."
+            )
         delta *= 30.0
-    return brentq(lambda v: fun(v, rtol), a, b, xtol=1e-15 * scale, rtol=1e-15, maxiter=200)
+    return brentq(tight, lo, hi, xtol=1e-15 * scale, rtol=1e-15, maxiter=200)
 
 
 def _full_film(pb, rtol):

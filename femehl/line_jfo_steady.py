@@ -84,27 +84,58 @@ against the flow, the regions are found in turn; all root finding is
    local minimum of p after its maximum (``d = q_2``, (6)) is exactly 0; that point is
    the reformation.  One cavity at most is handled for Reynolds.
 
-Integrators: :func:`scipy.integrate.solve_ivp`, DOP853 for a rigid slider (5 is then a
-quadrature), LSODA (stiff) for a Winkler film, both at ``rtol`` (default 1e-12), the
-load ``int p dx`` a second component of the same ODE; integration is split at the
-profile's ``kinks`` (where s'' jumps, e.g. the edges of a cosine-squared pocket).  The
+Integrators: :func:`scipy.integrate.solve_ivp` with DOP853 (explicit, order 8) at
+``rtol`` (default 1e-12): for a rigid slider (5) is a quadrature, and a Winkler film is
+only mildly stiff at such tolerances (its decay rate ``V/(beta k d^3)`` times the step
+stays in DOP853's stability region; ``method="Radau"`` for a much stiffer film, at a
+higher cost).  The load ``int p dx`` is a second component of the same ODE, the free
+boundaries are terminal events of the integration, and the integration is split at the
+profile's ``kinks`` (where s'' jumps, e.g. the edges of a cosine-squared pocket).  Each
+shooting root is bracketed at ``rtol = 1e-6`` and polished at ``rtol``.  The
 solution's own numerical error, :attr:`SteadyJFO.uncertainty`, is the change of every
-reported number when the whole solution is redone at a 100 times looser ``rtol``.
+reported number when the whole solution is redone at a 100 times looser ``rtol``
+(measured: halving ``rtol`` changes the results by < 1e-11).
 
-Reference geometries (:func:`pocket_slider`; numbers in ``docs`` and the tests)
---------------------------------------------------------------------------------
-* "outlet-cavity": the cylinder ``x^2/2`` on a Winkler foundation, ``k = 1,
-  beta = 10, hc = -0.5, L = 2`` (the scene of ``tests/test_line.py``), or a rigid
-  cylinder with ``hc > 0``: the film ruptures past the exit constriction and stays
-  cavitated to ``x = -L``; JFO and Reynolds coincide.
-* "reformation": a rigid converging slider with a cosine-squared pocket,
-  ``s = 0.1 (x + 2) + 0.3 cos^2(pi (x - 0.6)/0.8)`` for ``|x - 0.6| < 0.4``,
-  ``hc = 0.1, L = 2`` (any beta, V: p scales as V/beta): rupture entering the pocket,
-  reformation inside it, pressure build-up on the land downstream.
+Reference configurations (``V = 1, L = 2``; numbers at ``rtol = 1e-12``, their own
+uncertainty <= 2e-9; ``tests/test_line_jfo_reference.py`` pins those of "c1")
+---------------------------------------------------------------------------------------
+* "outlet-cavity" (rupture only; JFO and Reynolds coincide):
+
+  - b1, the Winkler cylinder of ``tests/test_line.py`` (``s = x^2/2, k = 1, beta = 10,
+    hc = -0.5``; the steady state of the default :class:`femehl.line.LineScene`):
+    rupture at x = -1.13900511824033, J = -0.148666329688834, load 1.05905170804220,
+    minimum film 0.126852581890131 at x = -1.06864;
+  - b2, the rigid cylinder (``k = inf, beta = 1, hc = 0.1``): rupture at
+    x = -0.210847583262465, J = -0.122228351683811, load 3.62837155510199, minimum
+    film 0.1 at x = 0.
+
+* "reformation" (rupture and reformation inside the domain), the slider of
+  :func:`pocket_slider` with its defaults (flat land from the outlet to x = 1, a
+  blended ramp to 0.2 (x - 1.25) toward the inlet, a pocket 0.3 deep (3 films) and 1
+  wide centred at x = -1), ``hc = 0.1``.  The film ruptures entering the pocket,
+  reforms inside it, and the pressure builds up again on the land downstream:
+
+  - c1, rigid, ``beta = 1``: rupture at x = -0.542391715898412, JFO reformation at
+    x = -1.16438139423915 (the pocket's converging half), J = -0.105289491061097,
+    load 12.6652545403082; Reynolds reformation at x = -0.563752778842461 (still in
+    the diverging half), outlet flux -0.111874199219468, load 16.1588612912422;
+    minimum film 0.1 at the outlet;
+  - c2, Winkler ``k = 100, beta = 10`` (a LineScene the FE solver runs directly:
+    ``LineScene(k=100, beta=10, profile=pocket_slider()[0], motion=Motion(gap=0.1,
+    velocity=TanhStart(1, 1)))``): rupture at x = -0.560838936849026, JFO reformation
+    at x = -0.828017184370354, J = -0.110826531820442, load 1.51139560116832;
+    Reynolds reformation at x = -0.573564147211335, outlet flux -0.115740101803692,
+    load 1.72281455904992.
+
+Use: ``s = steady_jfo(profile, hc, V=1.0, beta=10.0, k=100.0, L=2.0, kinks=kinks)``;
+``s.x, s.p, s.theta, s.d`` on the points, ``s.pressure(x)`` etc. anywhere,
+``s.rupture, s.reformation, s.J, s.load, s.film_min, s.uncertainty``.  A
+:class:`femehl.line.LineScene`'s ``shape`` is a valid ``profile``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass, field
@@ -115,6 +146,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .errors import SceneError, SolverError
 from .scene import check_finite, check_positive
+from .validation import check_int
 
 __all__ = [
     "Region",
@@ -153,7 +185,7 @@ def pocket_slider(
     (converging in the flow direction); ``blend = 0`` is a sharp corner, and
     ``ramp_start <= -L`` a plain linear slider.  The pocket and the blended ramp are C^1.
     The default is the "reformation" reference geometry of the module docstring (with
-    ``hc = 0.1``: film 0.1 on the land, pocket 3 films deep, 0.3 at the inlet).
+    ``hc = 0.1``: film 0.1 on the land, pocket 3 films deep, 0.25 at the inlet).
 
     Returns
     -------
@@ -393,7 +425,7 @@ class _Problem:
             return [V * (q - d) / (beta * d**3), y[0]]
 
         jac = None
-        if not rigid and self.method in ("Radau", "BDF", "LSODA"):
+        if not rigid and self.method in ("Radau", "BDF"):
 
             def jac(x, y):
                 d = film1(x, y[0])
@@ -651,7 +683,7 @@ def _solve(pb, model, rtol):
 # --------------------------------------------------------------------------
 # the public functions
 # --------------------------------------------------------------------------
-_METHODS = ("DOP853", "LSODA", "Radau", "BDF", "RK45")
+_METHODS = ("DOP853", "Radau", "BDF", "RK45")  # LSODA: its dense output misplaces events
 
 
 def _check(profile, hc, V, beta, k, L, kinks, rtol, method):
@@ -717,7 +749,7 @@ def _build(pb, model, regions, case, miss, n, x) -> dict:
     fluxes = tuple(-pb.V * r.q for r in full[::-1])
     load = float(sum(r._sol(r.b)[1, 0] for r in full))
     edges = [r.a for r in regions] + [L]
-    xs = np.linspace(-L, L, int(n)) if x is None else np.asarray(x, dtype=float)
+    xs = np.linspace(-L, L, int(n)) if x is None else np.array(x, dtype=float)  # a copy
     if x is None:
         xs = np.union1d(xs, edges)
     sol = {
@@ -779,13 +811,7 @@ def _result(pb, sol, uncertainty) -> SteadyJFO:
         _problem=pb,
     )
     xs = sol["x"]
-    return _replace_fields(shell, p=shell.pressure(xs), theta=shell.fraction(xs), d=shell.film(xs))
-
-
-def _replace_fields(obj, **kw):
-    import dataclasses
-
-    return dataclasses.replace(obj, **kw)
+    return dataclasses.replace(shell, p=shell.pressure(xs), theta=shell.fraction(xs), d=shell.film(xs))
 
 
 def _difference(a: dict, b: dict) -> dict:
@@ -802,6 +828,11 @@ def _difference(a: dict, b: dict) -> dict:
 
 def _steady(model, profile, hc, V, beta, k, L, kinks, x, n, rtol, method, estimate_error):
     profile, hc, V, beta, k, L, kinks, rtol, method = _check(profile, hc, V, beta, k, L, kinks, rtol, method)
+    n = check_int("n", n, 2)
+    if x is not None:
+        xa = np.asarray(x, dtype=float)
+        if xa.ndim != 1 or not np.all(np.isfinite(xa)) or np.abs(xa).max(initial=0.0) > L:
+            raise SceneError(f"x must be a 1-D array of finite points of [-L, L] = [-{L:g}, {L:g}].")
     pb = _Problem(profile, hc, V, beta, k, L, kinks, rtol, method)
     regions, case, miss = _solve(pb, model, rtol)
     sol = _build(pb, model, regions, case, miss, n, x)
@@ -859,7 +890,7 @@ _COMMON = """
     rtol : float, default: 1e-12
         Relative tolerance of the integrations (the root finding goes to machine precision).
     method : str, optional
-        :func:`scipy.integrate.solve_ivp` method; default DOP853 (rigid) or LSODA (Winkler).
+        :func:`scipy.integrate.solve_ivp` method (DOP853, Radau, BDF, RK45); default DOP853.
     estimate_error : bool, default: True
         Solve again at ``100 rtol`` and report the differences as ``uncertainty``.
 

@@ -228,6 +228,8 @@ def test_halving_the_tolerance_changes_nothing(sols):
         (dict(k=0.0), "Winkler stiffness"),
         (dict(rtol=1e-3), "rtol"),
         (dict(method="Euler"), "method"),
+        (dict(x=[0.0, 3.0]), "x must be"),
+        (dict(n=1), "n must be"),
     ],
 )
 def test_invalid_input(kw, match):

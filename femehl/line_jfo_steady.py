@@ -887,6 +887,7 @@ _COMMON = """
         Where to return p, theta, d; default ``n`` equally spaced points on [-L, L] with
         the free boundaries added.
     n : int, default: 2001
+        Number of the default points.
     rtol : float, default: 1e-12
         Relative tolerance of the integrations (the root finding goes to machine precision).
     method : str, optional
@@ -901,8 +902,8 @@ _COMMON = """
 
 
 def steady_jfo(
-    profile=None,
-    hc: float = 0.1,
+    profile,
+    hc: float,
     V: float = 1.0,
     beta: float = 10.0,
     k: float = math.inf,
@@ -919,8 +920,8 @@ def steady_jfo(
 
 
 def steady_reynolds(
-    profile=None,
-    hc: float = 0.1,
+    profile,
+    hc: float,
     V: float = 1.0,
     beta: float = 10.0,
     k: float = math.inf,
@@ -937,8 +938,8 @@ def steady_reynolds(
 
 
 def steady_full_film(
-    profile=None,
-    hc: float = 0.1,
+    profile,
+    hc: float,
     V: float = 1.0,
     beta: float = 10.0,
     k: float = math.inf,

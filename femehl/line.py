@@ -2,16 +2,18 @@
 
 The problem
 -----------
-The cylinder's gap is ``s(x) = x^2/2`` (normalized units, radius 1), the
-substrate a Winkler foundation ``w = -p/k``, and the film thickness
+The cylinder's gap is ``s(x) = x^2/2`` (normalized units, radius 1), or any rigid
+gap profile ``s(x)`` the scene is given (``LineScene(profile=...)``: a textured or
+inclined slider), the substrate a Winkler foundation ``w = -p/k``, and the film
+thickness
 
-    d(x, t) = hc(t) + x^2/2 + p(x, t)/k           (d = h - w, w < 0 under p > 0)
+    d(x, t) = hc(t) + s(x) + p(x, t)/k            (d = h - w, w < 0 under p > 0)
 
 obeys the 1-D normalized Reynolds equation, with the same conventions as the
 2-D problem of :mod:`femehl.scene` (docs/design.md, sections 1-2):
 
     beta d/dx( d^3 dp/dx ) = -V(t) dd/dx + dd/dt      on -L < x < L,
-    p(-L) = p(L) = 0,    p(x, 0) = 0  so  d(x, 0) = hc(0) + x^2/2.
+    p(-L) = p(L) = 0,    p(x, 0) = 0  so  d(x, 0) = hc(0) + s(x).
 
 The cylinder slides toward +x; in its frame the substrate moves toward -x,
 so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
@@ -78,6 +80,7 @@ from .scene import (
     check_positive,
 )
 from .substrates import Winkler
+from .validation import check_shape_values
 
 __all__ = ["LineScene", "line_nodes"]
 
@@ -91,7 +94,9 @@ def _default_motion() -> Motion:
 # --------------------------------------------------------------------------
 @dataclass(frozen=True)
 class LineScene(SceneEffects):
-    """A rigid cylinder (gap ``x^2/2``) on a lubricated Winkler foundation, normalized.
+    """A rigid cylinder (gap ``x^2/2``, or a given profile) on a lubricated Winkler foundation.
+
+    Normalized units (module docstring).
 
     Parameters
     ----------
@@ -115,6 +120,12 @@ class LineScene(SceneEffects):
         A viscoelastic foundation: the standard linear solid whose relaxed stiffness is
         ``k * G_inf`` and unrelaxed ``k * G0`` (its ``elastic`` is the Winkler(k) of this
         scene; :mod:`femehl.substrates.viscoelastic`); None: elastic.
+    profile : callable, optional
+        The rigid gap ``s(x)`` of the slider, a vectorized function of an array of x
+        returning one finite value per point (e.g. a textured slider,
+        ``lambda x: 0.1 * x + pocket(x)``); the film is ``d = hc + s(x) + p/k``.  It must
+        leave the film open at the start: ``s(x) + hc(0) > 0`` on [-L, L].  None: the
+        cylinder ``x^2/2``.  A callable cannot be written in a scene file.
     """
 
     default_method = "line"
@@ -127,6 +138,7 @@ class LineScene(SceneEffects):
     viscosity: object = field(default=None, metadata={"describe": "omit_default"})
     cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
     viscoelastic: object = field(default=None, metadata={"describe": "omit_default"})
+    profile: Callable | None = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
         from .cavitation import check_cavitation
@@ -176,7 +188,9 @@ class LineScene(SceneEffects):
             for t in times[times >= 0.0]:
                 self.motion.F(t)  # refuses a negative (pulling) load up front, naming the time
         hc0 = self.motion.hc(0.0)
-        if hc0 <= 0.0:
+        if self.profile is not None:
+            self._check_profile(hc0)
+        elif hc0 <= 0.0:
             raise SceneError(
                 f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
                 "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
@@ -210,19 +224,65 @@ class LineScene(SceneEffects):
         """True when the load F(t) is imposed (hc is then an unknown)."""
         return self.load is not None
 
-    @staticmethod
-    def shape(x):
-        """Rigid gap of the cylinder, ``x^2/2``."""
+    def _check_profile(self, hc0: float) -> None:
+        """SceneError unless ``profile`` is a vectorized, finite gap leaving the film open at t = 0."""
+        if not callable(self.profile):
+            raise SceneError(
+                f"LineScene(profile=...) must be a callable s(x) (the rigid gap), got "
+                f"{type(self.profile).__name__}: pass e.g. profile=lambda x: 0.5 * x**2, or None "
+                "for the cylinder."
+            )
+        xs = np.linspace(-self.L, self.L, 1001)
+        s = self._profile_values(xs)
+        if not np.all(np.isfinite(s)):
+            bad = xs[~np.isfinite(s)][0]
+            raise SceneError(
+                f"LineScene profile s(x) is not finite at x = {bad:.4g}: the rigid gap must be "
+                f"finite on the whole domain [-{self.L:g}, {self.L:g}]."
+            )
+        i = int(np.argmin(s))
+        if s[i] + hc0 <= 0.0:
+            raise SceneError(
+                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= 0 at x = {xs[i]:.4g}: with p = 0 at "
+                f"t = 0 the film must be open everywhere on [-L, L]. Start with hc(0) > {-s[i]:g} "
+                "(and indent with a ramp), or raise the profile."
+            )
+
+    def _profile_values(self, x: np.ndarray) -> np.ndarray:
+        """``profile(x)`` as a new float array of x's shape (SceneError naming the fix)."""
+        try:
+            v = self.profile(x)
+        except SceneError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - the user's code: say which function failed
+            raise SceneError(
+                f"LineScene profile s(x) raised {type(exc).__name__} on an array of x ({exc}): "
+                "it must accept a numpy array and return one value per point (vectorize with numpy)."
+            ) from None
+        v = np.asarray(v)
+        if v.shape != x.shape:
+            raise SceneError(
+                f"LineScene profile s(x) returned shape {v.shape} for x of shape {x.shape}: "
+                "return one value per point (vectorize with numpy, e.g. 0 * x + c for a constant)."
+            )
+        return check_shape_values("LineScene profile s(x)", v, x.shape)
+
+    def shape(self, x):
+        """Rigid gap ``s(x)``: the scene's ``profile``, or the cylinder's ``x^2/2``."""
         x = np.asarray(x, dtype=float)
-        return 0.5 * x * x
+        if self.profile is None:
+            return 0.5 * x * x
+        return self._profile_values(x)
 
     def contact_halfwidth(self) -> float | None:
         """Largest dry (Hertz-Winkler) contact half width of the run, when it can be told.
 
         Imposed gap: ``a = sqrt(-2 hc_min)`` (0 if the gap stays open).  Imposed
         load: ``F = (2/3) k a^3``.  None for gap or load histories that are
-        arbitrary callables.
+        arbitrary callables, and for a user ``profile`` (the estimate is the cylinder's).
         """
+        if self.profile is not None:
+            return None
         if self.load is None:
             gap = self.motion.gap
             if isinstance(gap, RampHold):

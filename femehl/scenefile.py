@@ -35,7 +35,8 @@ Line contact (a rigid cylinder, gap x^2/2, on a Winkler foundation; see
 kind = "winkler"`` and gives a :class:`femehl.line.LineScene` (k, beta, motion,
 L); its [run] takes method = "line", n_elements, grading ("uniform" or a size
 ratio >= 1), scheme, t_end, dt, store_every.  See
-``examples/cylinder_winkler.toml``.
+``examples/cylinder_winkler.toml``.  A user gap profile (``LineScene(profile=...)``, a
+Python function) exists only in Python.
 
 A height map file is an ``.npz`` with arrays x, y, z (``np.savez``), its path
 relative to the scene file; so is a [run] mesh that is not a ladder name

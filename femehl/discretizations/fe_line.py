@@ -7,7 +7,8 @@ in weak form: find p in P1, p(-L) = p(L) = 0, such that for every P1 test functi
 
 (the Couette term integrated by parts; its boundary term vanishes since q(+-L) = 0),
 with the forms of :mod:`femehl.fe.forms`.  The film points are the element centroids
-``(x_e, 0)``; the shape is the scene's cylinder ``x^2/2``.  The load is per unit length,
+``(x_e, 0)``; the shape is the scene's rigid gap
+``LineScene.shape`` (the cylinder ``x^2/2`` or its ``profile``).  The load is per unit length,
 ``int p dx``.  Only local substrates (Winkler, rigid) have a line operator; with them
 no dense matrix is built anywhere.
 """

@@ -71,10 +71,13 @@ def test_readme_block_runs(index, tmp_path, monkeypatch, capsys, paper_reference
     elif "cavitation=" in python_blocks()[index]:
         # the cavitation block: half-Sommerfeld reports the clipped load (above the
         # full-Sommerfeld one, whose sub-ambient lobe it drops) and a cavitated area; the
-        # Reynolds condition a cavitated area and a positive full-film source
+        # Reynolds condition a cavitated area and a positive full-film source; JFO below
         (hs_load, hs_full, hs_area), (re_area, re_source) = _floats(out[0]), _floats(out[1])
         assert hs_load > 1.02 * hs_full and hs_area > 1.0
         assert re_area > 1.0 and re_source > 0.0
+        # JFO: a cavity, the liquid balance to the solver's tolerance, a filling in [0, 1]
+        jfo_area, imbalance, theta_min = _floats(out[2])
+        assert jfo_area > 1.0 and imbalance < 1e-7 and 0.0 <= theta_min < 1.0
     elif "femehl.Layer(thickness" in python_blocks()[index]:
         # the coated contact: a layer as thick as the contact is stiffer than the half space,
         # so the same indentation carries more load (same mesh, dt and horizon)

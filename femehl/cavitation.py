@@ -362,11 +362,11 @@ class JFOCavitation(_Model):
     of a node on the cavity's edge, where both ``p`` and ``v`` are about 0 (a period-2
     cycle of the lagged set on the paper case's fine mesh with a margin of 0, every 3 to 5
     steps with it, its negative pressure <= 5e-4 of the peak); it bounds the overfill of
-    a cavitated node, which the liquid balance still counts.  The liquid is conserved by every step whatever the set (the rows are the
-    mass balance of the solved content, including at the nodes that change), so the set's
-    lag costs a one-step transient -- a pressure slightly below 0 at a node about to
-    rupture (``info["p_negative_min"]``) or a filling slightly above 1 at one about to
-    reform -- and never mass.
+    a cavitated node, which the liquid balance still counts.  The liquid is conserved by
+    every step whatever the set (the rows are the mass balance of the solved content,
+    including at the nodes that change), so the set's lag costs a one-step transient -- a
+    pressure slightly below 0 at a node about to rupture (``info["p_negative_min"]``) or a
+    filling slightly above 1 at one about to reform -- and never mass.
 
     **Reported per step** (``state.info``, summary columns; whole-plane figures):
     ``cavitated_area`` (``sum g_i`` over the next set), ``liquid_volume`` (the content

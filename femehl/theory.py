@@ -789,8 +789,12 @@ def hd_piezo_film(beta, load, alpha, which="central", Rx=1.0, Ry=1.0, nu=0.5, ep
     numerical cases were fitted.  Stated accuracy: none could be found in the accessible
     sources (the paper itself was not accessible).  An optical experiment
     (Koye and Winer, J. Lubr. Technol. 103 (1981) 284) found minimum films 30 % above
-    ``H_min`` on average.  In soft EHL with a moderate ``alpha``, ``W`` is one or two
-    orders above that range and ``G`` one order below it: the formulas are extrapolated.
+    ``H_min`` on average.  Soft EHL with a moderate ``alpha`` lies outside that range:
+    ``G <~ 400`` (:func:`hd_material_parameter`) against ``G ~ 4600`` for steel on a
+    mineral oil, and the Hertz load of the unit sphere at ``hc = -1`` is
+    ``W = 2.1e-5`` at ``eps = 1e-3``, about 50 times a 10 N load on a 10 mm steel ball
+    (``W = 4.3e-7``): the formulas are extrapolated there (``benchmarks/hamrock_dowson.md``
+    compares them with femehl).
 
     ``alpha -> 0``: ``G -> 0`` and the film vanishes like ``alpha^0.53`` (central) or
     ``alpha^0.49`` (minimum).  The formulas describe films that the viscosity rise makes,

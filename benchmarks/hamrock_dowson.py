@@ -302,7 +302,8 @@ def findings(base, fine) -> list[str]:
     best_c = [r["film_center"] / max(r["iso_center"], r["piezo_center"]) for r in ok]
     best_m = [r["film_min"] / max(r["iso_min"], r["piezo_min"]) for r in ok]
     out.append(
-        "* **Against the larger of the two formulas** (the regime's): minimum film "
+        "* **Against the larger of the two formulas, film by film** (the verdict above uses the "
+        "minimum-film regime for both): minimum film "
         f"{min(best_m):.2f} to {max(best_m):.2f}, central film {min(best_c):.2f} to {max(best_c):.2f}. "
         "The viscosity rise thickens femehl's central film much more than its minimum (exit) film; "
         "neither formula follows the central film through the crossover, where femehl's film is "

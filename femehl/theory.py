@@ -39,6 +39,13 @@ Functions
 :func:`hd_eps_power`               the residual power of ``eps`` in a Hamrock-Dowson film
 :func:`hd_film_band`               the band of a Hamrock-Dowson film over a range of ``eps``
 :func:`hd_groups`                  the Hamrock-Dowson groups ``U``, ``W`` of a normalized state
+:func:`hd_material_parameter`      the material group ``G = alpha E'`` of femehl's Barus ``alpha``
+:func:`hd_piezo_central_film`      Hamrock & Dowson (1977) piezoviscous-elastic central film ``d_c``
+:func:`hd_piezo_minimum_film`      Hamrock & Dowson (1977) piezoviscous-elastic minimum film ``d_min``
+:func:`hd_piezo_film`              either of the two, by name
+:func:`hd_piezo_eps_power`         the residual power of ``eps`` in a piezoviscous-elastic film
+:func:`hd_regime_parameters`       Hamrock's regime parameters ``g_V``, ``g_E`` (independent of ``eps``)
+:func:`hd_elastic_regime`          isoviscous- or piezoviscous-elastic: which formula gives more film
 :func:`ellipticity`                the ellipticity ``k = a_y/a_x`` of the Hertz contact ellipse
 :func:`hertz_load`                 the dry Hertz load at indentation ``delta`` (sphere, ellipsoid)
 :func:`scaling_exponents`          large-``beta`` film exponents, with their sources
@@ -63,6 +70,7 @@ from .errors import SceneError
 
 __all__ = [
     "DEFAULT_EPS",
+    "ELASTIC_REGIMES",
     "EPS_RANGE",
     "ellipticity",
     "hd_central_film",
@@ -70,7 +78,14 @@ __all__ = [
     "hd_film",
     "hd_film_band",
     "hd_groups",
+    "hd_elastic_regime",
+    "hd_material_parameter",
     "hd_minimum_film",
+    "hd_piezo_central_film",
+    "hd_piezo_eps_power",
+    "hd_piezo_film",
+    "hd_piezo_minimum_film",
+    "hd_regime_parameters",
     "hertz_load",
     "scaling_exponents",
 ]
@@ -87,6 +102,10 @@ HD1978 = (
     "for materials of low elastic modulus I - fully flooded conjunction', "
     "ASME J. Lubr. Technol. 100 (1978) 236-245"
 )
+HD1977 = (
+    "B. J. Hamrock and D. Dowson, 'Isothermal elastohydrodynamic lubrication of point contacts, "
+    "Part III - fully flooded results', ASME J. Lubr. Technol. 99 (1977) 264-276"
+)
 SEV2013 = (
     "J. H. Snoeijer, J. Eggers and C. H. Venner, 'Similarity theory of lubricated "
     "Hertzian contacts', Phys. Fluids 25 (2013) 101705"
@@ -96,6 +115,12 @@ SEV2013 = (
 _HD_FITS = {
     "central": (7.32, 0.64, -0.22, 0.72, 0.28),
     "minimum": (7.43, 0.65, -0.21, 0.85, 0.31),
+}
+
+# name -> (A, a, g, b, C, D) of  H = A U^a G^g W^b (1 - C exp(-D k))
+_HD_PIEZO_FITS = {
+    "central": (2.69, 0.67, 0.53, -0.067, 0.61, 0.73),
+    "minimum": (3.63, 0.68, 0.49, -0.073, 1.0, 0.68),
 }
 
 _K_METHODS = ("hertz", "hamrock_brewe", "hd1977")
@@ -165,6 +190,12 @@ def _which(which: str) -> tuple:
     return _HD_FITS[which]
 
 
+def _which_piezo(which: str) -> tuple:
+    if which not in _HD_PIEZO_FITS:
+        raise SceneError(f"Unknown Hamrock-Dowson film {which!r}: use 'central' or 'minimum'.")
+    return _HD_PIEZO_FITS[which]
+
+
 def _out(x):
     x = np.asarray(x, dtype=float)
     return float(x) if x.ndim == 0 else x
@@ -174,6 +205,10 @@ _BETA_HINT = "beta = (2/3)(h_inf^2/R)(pi G)/(eta V_ss) is a positive number, e.g
 _LOAD_HINT = (
     "The normalized load F = F*/(4 pi G sqrt(R) h_inf^(3/2)) must be > 0 "
     "(e.g. the Hertz load at hc = -1, hertz_load(1.0) = 4/(3 pi))."
+)
+_ALPHA_HINT = (
+    "alpha is femehl's Barus coefficient (eta = eta0 exp(alpha p), p in units of "
+    "4 pi G sqrt(h_inf/R)), >= 0; femehl.Barus.from_si(alpha_SI, dim).alpha converts an SI value."
 )
 _R_HINT = "Give radii of curvature in units of R, e.g. Rx=1.0, Ry=1.0 for the unit sphere."
 
@@ -655,6 +690,366 @@ def hd_film_band(beta, load, which="central", eps_range=EPS_RANGE, Rx=1.0, Ry=1.
     d0 = np.asarray(hd_film(beta, load, which, Rx=Rx, Ry=Ry, nu=nu, eps=e0, k=k))
     d1 = np.asarray(hd_film(beta, load, which, Rx=Rx, Ry=Ry, nu=nu, eps=e1, k=k))
     return _out(np.minimum(d0, d1)), _out(np.maximum(d0, d1))
+
+
+# ------------------------------------------------------------- Hamrock & Dowson: piezoviscous
+
+
+def hd_material_parameter(alpha, nu=0.5, eps=DEFAULT_EPS):
+    r"""Hamrock-Dowson material group ``G = alpha* E'`` of femehl's Barus coefficient ``alpha``.
+
+    femehl's Barus law is ``eta = eta0 exp(alpha p)`` with ``p`` in units of the pressure
+    scale ``p_s = 4 pi G_s sqrt(h_inf/R)`` (docs/design.md sections 2 and 11; ``G_s`` the
+    substrate's shear modulus), so the SI coefficient is ``alpha* = alpha / p_s``
+    (:meth:`femehl.Barus.from_si` is the inverse).  With ``E' = 8 G_s/c``
+    (:func:`hd_groups`, ``c = 2(1 - nu)``)::
+
+        G = alpha* E' = (alpha / (4 pi G_s sqrt(eps))) (8 G_s / c) = 2 alpha / (pi c sqrt(eps))
+
+    e.g. ``G = 20.13 alpha`` for an incompressible substrate at ``eps = 1e-3``.  The shear
+    modulus cancels; ``eps = h_inf/R`` does not (the normalized problem leaves it free, see
+    the module docstring).  For comparison: a mineral oil on steel (``alpha* ~ 2e-8 /Pa``,
+    ``E' ~ 2.3e11 Pa``) has ``G ~ 4600``; femehl's moderate ``alpha p_max <= 4`` at
+    ``eps = 1e-3`` is ``G <~ 400``.
+
+    Parameters
+    ----------
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0; ``femehl.Barus(alpha).alpha``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate, in (-1, 0.5].
+    eps : float or array_like, default: DEFAULT_EPS
+        ``h_inf/R``.
+
+    Returns
+    -------
+    float or ndarray
+        ``G``, broadcast over ``alpha`` and ``eps``.
+
+    Raises
+    ------
+    SceneError
+        If ``alpha`` is negative or not finite, or another input is invalid.
+    """
+    a = _array("Barus alpha", alpha, _ALPHA_HINT, allow_zero=True)
+    e = _eps(eps)
+    c = 2.0 * (1.0 - _nu(nu))
+    return _out(2.0 * a / (math.pi * c * np.sqrt(e)))
+
+
+def hd_piezo_eps_power(which: str = "central") -> float:
+    r"""Residual power of ``eps = h_inf/R`` in a piezoviscous-elastic film in femehl units.
+
+    With ``H = A U^a G^g W^b f(k)``, ``U ~ eps^2``, ``W ~ eps^(3/2)``, ``G ~ eps^(-1/2)``
+    (:func:`hd_groups`, :func:`hd_material_parameter`) and ``d = H Rx/eps`` the film goes
+    as ``eps^(2a + 1.5 b - 0.5 g - 1)``: central ``2(0.67) - 1.5(0.067) - 0.5(0.53) - 1 =
+    -0.0255``, minimum ``2(0.68) - 1.5(0.073) - 0.5(0.49) - 1 = +0.0055``: over ``eps`` in
+    [1e-4, 1e-2] a factor 1.12 (central) and 1.03 (minimum).
+
+    Parameters
+    ----------
+    which : {'central', 'minimum'}
+        Which film.
+
+    Returns
+    -------
+    float
+        The power ``2a + 1.5 b - 0.5 g - 1``.
+    """
+    _, a, g, b, _, _ = _which_piezo(which)
+    return 2.0 * a + 1.5 * b - 0.5 * g - 1.0
+
+
+def hd_piezo_film(beta, load, alpha, which="central", Rx=1.0, Ry=1.0, nu=0.5, eps=DEFAULT_EPS, k=None):
+    r"""Hamrock & Dowson (1977) piezoviscous-elastic (hard EHL) film, in units of ``h_inf``.
+
+    Formulas (fully flooded, isothermal, Newtonian; Barus-type viscosity rise; elliptical
+    point contacts)::
+
+        H_min = 3.63 U^0.68 G^0.49 W^-0.073 (1 - exp(-0.68 k))
+        H_c   = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 exp(-0.73 k))
+
+    with ``H = h*/Rx*``, ``U = eta0 u/(E' Rx*)``, ``G = alpha* E'``, ``W = F*/(E' Rx*^2)``
+    and ``k`` the ellipticity (transverse over entrainment-direction semi-axis).
+
+    Source: B. J. Hamrock and D. Dowson, 'Isothermal elastohydrodynamic lubrication of
+    point contacts, Part III - fully flooded results', ASME J. Lubr. Technol. 99 (1977)
+    264-276.  Confirmed here: ``H_min`` with its coefficients, from the ASME abstract page
+    of that paper (which also gives ``k = 1.03 (Ry/Rx)^0.64``).  ``H_c`` with its
+    coefficients is the central-film companion commonly quoted with it (B. J. Hamrock,
+    *Fundamentals of Fluid Film Lubrication*, NASA RP-1255, 1991; Hamrock, Schmid and
+    Jacobson, 2004; not checked there): confirmed only from public implementations of the
+    Hamrock-Dowson formulas (the ``sciforge-core`` crate on docs.rs; the Python
+    ``tribology`` package), not from the paper.
+
+    Range of validity (Part III abstract): ``k`` from 1 (ball on plate) to 8 (approaching
+    line contact); ``U`` over nearly two orders of magnitude and ``W`` over one order
+    around hard-EHL values; material groups of bronze, steel and silicon nitride with
+    paraffinic and naphthenic mineral oils (``G`` of a few thousand).  Thirty-four
+    numerical cases were fitted.  Stated accuracy: none could be found in the accessible
+    sources (the paper itself was not accessible).  An optical experiment
+    (Koye and Winer, J. Lubr. Technol. 103 (1981) 284) found minimum films 30 % above
+    ``H_min`` on average.  Soft EHL with a moderate ``alpha`` lies outside that range:
+    ``G <~ 400`` (:func:`hd_material_parameter`) against ``G ~ 4600`` for steel on a
+    mineral oil, and the Hertz load of the unit sphere at ``hc = -1`` is
+    ``W = 2.1e-5`` at ``eps = 1e-3``, about 50 times a 10 N load on a 10 mm steel ball
+    (``W = 4.3e-7``): the formulas are extrapolated there (``benchmarks/hamrock_dowson.md``
+    compares them with femehl).
+
+    ``alpha -> 0``: ``G -> 0`` and the film vanishes like ``alpha^0.53`` (central) or
+    ``alpha^0.49`` (minimum).  The formulas describe films that the viscosity rise makes,
+    so they do not apply there: the isoviscous-elastic formulas (:func:`hd_film`) do.
+    ``alpha = 0`` is accepted and returns 0.  :func:`hd_elastic_regime` says which of
+    the two formulas applies.
+
+    Conversion to femehl's normalization (:func:`hd_groups`, :func:`hd_material_parameter`)::
+
+        U = (pi c/(24 Rx)) eps^2/beta,  W = (pi c/(2 Rx^2)) eps^(3/2) F,
+        G = 2 alpha/(pi c sqrt(eps)),  d = H Rx/eps
+
+    so ``d_c ~ beta^-0.67 alpha^0.53 F^-0.067 eps^-0.0255`` and
+    ``d_min ~ beta^-0.68 alpha^0.49 F^-0.073 eps^0.0055`` (:func:`hd_piezo_eps_power`).
+
+    Parameters
+    ----------
+    beta : float or array_like
+        The ``beta`` of femehl's normalization (> 0, formed with the ambient viscosity).
+    load : float or array_like
+        Normalized load ``F = int p dA`` (> 0).
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0).
+    which : {'central', 'minimum'}
+        Which film.
+    Rx, Ry : float, default: 1.0
+        Radii of curvature along and across the sliding direction (units of ``R``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate, in (-1, 0.5].
+    eps : float or array_like, default: DEFAULT_EPS
+        ``h_inf/R``.
+    k : float, optional
+        Ellipticity; default :func:`ellipticity` ``(Rx, Ry)`` (exact Hertz, 1 for a sphere).
+
+    Returns
+    -------
+    float or ndarray
+        The film thickness ``d`` in units of ``h_inf``, broadcast over ``beta``, ``load``,
+        ``alpha`` and ``eps``.
+
+    Raises
+    ------
+    SceneError
+        If ``beta`` or ``load`` is not positive, ``alpha`` is negative, ``which`` is
+        unknown, or another input is invalid.
+    """
+    A, a, g, b, C, D = _which_piezo(which)
+    U, W = hd_groups(beta, load, Rx=Rx, nu=nu, eps=eps)
+    G = hd_material_parameter(alpha, nu=nu, eps=eps)
+    if k is None:
+        k = ellipticity(Rx, Ry)
+    kk = _array("Ellipticity k", k, "Give k > 0, or leave k=None to take it from Rx and Ry.")
+    rx = _array("Rx", Rx, _R_HINT)
+    e = _eps(eps)
+    H = A * np.asarray(U) ** a * np.asarray(G) ** g * np.asarray(W) ** b * (1.0 - C * np.exp(-D * kk))
+    return _out(H * rx / e)
+
+
+def hd_piezo_central_film(beta, load, alpha, Rx=1.0, Ry=1.0, nu=0.5, eps=DEFAULT_EPS, k=None):
+    r"""Hamrock & Dowson (1977) piezoviscous-elastic central film ``d_c`` in units of ``h_inf``.
+
+    ``H_c = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 exp(-0.73 k))``, converted as in
+    :func:`hd_piezo_film` (which gives the source, what was confirmed, the range of
+    validity and why the formula does not apply as ``alpha -> 0``).
+
+    Parameters
+    ----------
+    beta : float or array_like
+        The ``beta`` of femehl's normalization (> 0).
+    load : float or array_like
+        Normalized load ``F`` (> 0).
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0).
+    Rx, Ry : float, default: 1.0
+        Radii of curvature (units of ``R``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate.
+    eps : float or array_like, default: DEFAULT_EPS
+        ``h_inf/R``.
+    k : float, optional
+        Ellipticity; default from ``Rx``, ``Ry`` (exact Hertz).
+
+    Returns
+    -------
+    float or ndarray
+        ``d_c``.
+
+    Raises
+    ------
+    SceneError
+        If an input is invalid (see :func:`hd_piezo_film`).
+
+    Examples
+    --------
+    The unit sphere under the Hertz load of ``hc = -1`` at ``beta = 200``, ``alpha = 10``:
+
+    >>> from femehl import theory
+    >>> round(theory.hd_piezo_central_film(200.0, theory.hertz_load(1.0), 10.0), 4)
+    0.0457
+    """
+    return hd_piezo_film(beta, load, alpha, "central", Rx=Rx, Ry=Ry, nu=nu, eps=eps, k=k)
+
+
+def hd_piezo_minimum_film(beta, load, alpha, Rx=1.0, Ry=1.0, nu=0.5, eps=DEFAULT_EPS, k=None):
+    r"""Hamrock & Dowson (1977) piezoviscous-elastic minimum film ``d_min`` in units of ``h_inf``.
+
+    ``H_min = 3.63 U^0.68 G^0.49 W^-0.073 (1 - exp(-0.68 k))``, converted as in
+    :func:`hd_piezo_film` (which gives the source, what was confirmed, the range of
+    validity and why the formula does not apply as ``alpha -> 0``).
+
+    Parameters
+    ----------
+    beta : float or array_like
+        The ``beta`` of femehl's normalization (> 0).
+    load : float or array_like
+        Normalized load ``F`` (> 0).
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0).
+    Rx, Ry : float, default: 1.0
+        Radii of curvature (units of ``R``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate.
+    eps : float or array_like, default: DEFAULT_EPS
+        ``h_inf/R``.
+    k : float, optional
+        Ellipticity; default from ``Rx``, ``Ry`` (exact Hertz).
+
+    Returns
+    -------
+    float or ndarray
+        ``d_min``.
+
+    Raises
+    ------
+    SceneError
+        If an input is invalid (see :func:`hd_piezo_film`).
+    """
+    return hd_piezo_film(beta, load, alpha, "minimum", Rx=Rx, Ry=Ry, nu=nu, eps=eps, k=k)
+
+
+def hd_regime_parameters(beta, load, alpha, Rx=1.0, nu=0.5):
+    r"""Hamrock's regime parameters ``(g_V, g_E)`` of a normalized femehl state.
+
+    Hamrock and Dowson chart the four regimes of fluid-film lubrication (isoviscous-rigid,
+    piezoviscous-rigid, isoviscous-elastic, piezoviscous-elastic) on the viscosity and
+    elasticity parameters (B. J. Hamrock, *Fundamentals of Fluid Film Lubrication*, NASA
+    RP-1255, 1991; Esfahanian and Hamrock 1991; neither checked here: the definitions are
+    those of the task brief and of a public transcription, GitHub jl293/tribopy)::
+
+        g_V = G W^3 / U^2,     g_E = W^(8/3) / U^2
+
+    (the film parameter is ``g_H = H W^2/U^2``).  With the groups of :func:`hd_groups` and
+    :func:`hd_material_parameter` the ratio ``eps = h_inf/R`` cancels from both::
+
+        g_E = (pi c/(2 Rx^2))^(8/3) (pi c/(24 Rx))^-2 F^(8/3) beta^2
+        g_V = (2 alpha/(pi c)) (pi c/(2 Rx^2))^3 (pi c/(24 Rx))^-2 F^3 beta^2
+
+    so, unlike the films, the regime is fixed by femehl's normalized state and ``alpha``
+    alone.  Large ``g_E`` is elastic, large ``g_V`` piezoviscous; the published regime
+    boundaries could not be checked here (see :func:`hd_elastic_regime`).
+
+    Parameters
+    ----------
+    beta : float or array_like
+        The ``beta`` of femehl's normalization (> 0).
+    load : float or array_like
+        Normalized load ``F`` (> 0).
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0).
+    Rx : float or array_like, default: 1.0
+        Radius of curvature along the sliding direction (units of ``R``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate.
+
+    Returns
+    -------
+    g_V : float or ndarray
+        The viscosity parameter (0 for ``alpha = 0``).
+    g_E : float or ndarray
+        The elasticity parameter.
+
+    Raises
+    ------
+    SceneError
+        If ``beta`` or ``load`` is not positive, ``alpha`` is negative, or another input is
+        invalid.
+    """
+    b = _array("beta", beta, _BETA_HINT)
+    f = _array("Load F", load, _LOAD_HINT)
+    a = _array("Barus alpha", alpha, _ALPHA_HINT, allow_zero=True)
+    rx = _array("Rx", Rx, _R_HINT)
+    c = 2.0 * (1.0 - _nu(nu))
+    u_coef = math.pi * c / (24.0 * rx)
+    w_coef = math.pi * c / (2.0 * rx**2)
+    g_E = w_coef ** (8.0 / 3.0) * f ** (8.0 / 3.0) * b**2 / u_coef**2
+    g_V = 2.0 * a / (math.pi * c) * w_coef**3 * f**3 * b**2 / u_coef**2
+    g_V, g_E = np.broadcast_arrays(g_V, g_E)
+    return _out(g_V), _out(g_E)
+
+
+#: the two elastic regimes :func:`hd_elastic_regime` tells apart
+ELASTIC_REGIMES = ("isoviscous-elastic", "piezoviscous-elastic")
+
+
+def hd_elastic_regime(beta, load, alpha, Rx=1.0, Ry=1.0, nu=0.5, eps=DEFAULT_EPS, k=None):
+    r"""Isoviscous- or piezoviscous-elastic: which Hamrock-Dowson minimum film is the larger.
+
+    The criterion is derived here, not taken from a published chart: a viscosity that
+    rises with pressure can only thicken the film, and each formula is an asymptote of
+    its own regime (the isoviscous-elastic one as ``G -> 0``, the piezoviscous-elastic
+    one where the viscosity rise sets the film), so the state is placed in the regime
+    whose formula predicts the larger minimum film, :func:`hd_minimum_film` (1978) or
+    :func:`hd_piezo_minimum_film` (1977).  The two are equal where
+    ``alpha^0.49 ~ beta^0.03 F^-0.137 eps^-0.0205`` (times a constant; for the unit
+    sphere under the Hertz load of ``hc = -1`` at ``eps = 1e-3``: ``alpha = 9.1`` at
+    ``beta = 200``, 10.1 at ``beta = 1000``), which is not a line of constant
+    ``g_V/g_E``.  Hamrock and Dowson's regime charts (Esfahanian and Hamrock, 'Fluid-film
+    lubrication regimes revisited', Tribol. Trans. 34 (1991); citation and content not
+    checked here) bound the regimes in the ``(g_V, g_E)`` plane with their own, refitted
+    formulas; those boundaries could not be checked, so the rigid regimes (small
+    ``g_E``) are not classified: the function assumes an elastic contact (check that the
+    deflection is much larger than the film).
+
+    Parameters
+    ----------
+    beta : float or array_like
+        The ``beta`` of femehl's normalization (> 0).
+    load : float or array_like
+        Normalized load ``F`` (> 0).
+    alpha : float or array_like
+        femehl's Barus coefficient (>= 0).
+    Rx, Ry : float, default: 1.0
+        Radii of curvature (units of ``R``).
+    nu : float, default: 0.5
+        Poisson ratio of the substrate.
+    eps : float or array_like, default: DEFAULT_EPS
+        ``h_inf/R``.
+    k : float, optional
+        Ellipticity; default from ``Rx``, ``Ry`` (exact Hertz).
+
+    Returns
+    -------
+    str or ndarray of str
+        ``"isoviscous-elastic"`` or ``"piezoviscous-elastic"`` (:data:`ELASTIC_REGIMES`).
+
+    Raises
+    ------
+    SceneError
+        If an input is invalid.
+    """
+    iso = np.asarray(hd_minimum_film(beta, load, Rx=Rx, Ry=Ry, nu=nu, eps=eps, k=k))
+    piezo = np.asarray(hd_piezo_minimum_film(beta, load, alpha, Rx=Rx, Ry=Ry, nu=nu, eps=eps, k=k))
+    iso, piezo = np.broadcast_arrays(iso, piezo)
+    label = np.where(piezo > iso, ELASTIC_REGIMES[1], ELASTIC_REGIMES[0])
+    return str(label) if label.ndim == 0 else label
 
 
 # ---------------------------------------------------------------------- scaling exponents

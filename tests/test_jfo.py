@@ -138,7 +138,7 @@ def paper_runs():
     out = {}
     for c in ("jfo", "reynolds"):
         s = dataclasses.replace(sc, fluid=Fluid(200.0, cavitation=c))
-        out[c] = femehl.solve(s, t_end=5.0, dt=0.01, mesh="coarse", scheme="bdf2", estimate=False)
+        out[c] = femehl.solve(s, t_end=5.0, dt=0.02, mesh="coarse", scheme="bdf2", estimate=False)
     return out
 
 
@@ -152,8 +152,8 @@ def test_paper_case(paper_runs):
     # the set's one-step transient: a node about to rupture, never below 1 % of the peak
     assert min(st.info["p_negative_min"] / max(st.p_max, 1e-9) for st in jfo.states) > -0.01
     assert f.info["p_negative_min"] == 0.0  # steady sliding: the set has settled
-    # the cavity opens to the rim, nothing reforms: close to Reynolds (1.2 % on this mesh,
-    # 0.12 % on the medium one: the rupture front's discretization)
+    # the cavity opens to the rim, nothing reforms: close to Reynolds (1.2 % on this mesh at
+    # dt = 0.01, 0.12 % on the medium one: the rupture front's discretization)
     assert f.film_min == pytest.approx(rey.final.film_min, rel=0.02)
     assert f.load == pytest.approx(rey.final.load, rel=1e-3)
 
@@ -271,9 +271,11 @@ def test_free_indenter_and_the_tracked_elastic_products():
         state = stepper.step(state, state.t + 0.02, 0.02)
         assert state.d.min() > 0.0
     n = stepper.disc.n
+    # the solver keeps each tracked C x within 1e-9 of the true one (2-norm, checked by two
+    # random probes whose estimate is within a factor ~2 of the error): 1e-8 here
     for x, cx in stepper.solver.solutions + stepper.solver.directions:
         true = stepper.C @ x[:n]
-        assert np.abs(cx - true).max() < 1e-9 * np.abs(true).max()
+        assert np.linalg.norm(cx - true) < 1e-8 * np.linalg.norm(true)
     direct = femehl.solve(sc, t_end=2.0, dt=0.02, mesh="coarse", estimate=False, linear_solver="lu")
     assert state.film_min == pytest.approx(direct.final.film_min, rel=1e-5)
     assert state.hc == pytest.approx(direct.final.hc, rel=1e-6)

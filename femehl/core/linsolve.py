@@ -22,8 +22,11 @@ Solvers are registered in :data:`LINEAR_SOLVERS` by name:
     recent ``A`` as the preconditioner (one triangular-solve pair + one dense ``C``
     product each).  The TRUE residual ``b - A x`` is checked before a solution is
     accepted (sparse work, from the tracked ``C x``); otherwise the system is solved
-    directly.  The LU is refreshed by cost balancing: when the preconditioned iterations
-    of the last solve cost more than the average cost per solve since the last
+    directly.  The tracked ``C x`` (a combination of recycled ``C z``, never formed)
+    inherits their rounding generation after generation; two fixed random probes check
+    it to 1e-9 at the cost of two dot products, and it is formed when it fails (with the
+    fast operator: every 8 generations).  The LU is refreshed by cost balancing: when
+    the preconditioned iterations of the last solve cost more than the average cost per solve since the last
     factorization (factorization included), or when ``c_0 = a0/dt`` changed by more than
     10 %.  ``refactor_after=n`` instead refreshes when a solve needed more than ``n``
     preconditioned iterations.  With the *fast* operator (:mod:`femehl.hmatrix`, ``C``
@@ -45,6 +48,7 @@ All state (the factor, the recycled directions, the cost of one iteration, count
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from functools import cached_property
@@ -359,9 +363,11 @@ class SwitchedLU:
         return x
 
 
-_EPS = float(np.finfo(float).eps)
-#: a tracked C x whose rounding-error bound exceeds this (relative) is formed instead
-_TRACK_RTOL = 1e-10
+#: a tracked C x whose error exceeds this (relative, by the random probes) is formed instead
+_TRACK_RTOL = 1e-9
+#: without probes (the fast operator): C x is formed after this many generations of tracking
+_MAX_TRACKED = 8
+_PROBES = 2
 
 #: name -> linear solver class
 LINEAR_SOLVERS: dict[str, type] = {}
@@ -543,7 +549,8 @@ class RecycledGCR:
         self.direct = DirectSolver()
         self.factor: _Factor | None = None
         self.solutions: list = []  # recent (x, C x)
-        self._solution_errors: list = []  # bounds on the rounding error of their tracked C x
+        self._solution_ages: list = []  # generations of tracking behind their C x
+        self._probe = None  # (w, w^T C): checks a tracked C x at the cost of two dot products
         self.directions: list = []  # recent preconditioned (z, C z)
         self.t_iter = 0.0  # wall time of one preconditioned iteration (s)
         self.history: list = []  # relative residuals of the last solve
@@ -577,7 +584,7 @@ class RecycledGCR:
         if fresh:
             f = self._refactor(op, t)
         t0 = time.perf_counter()
-        x, Cx, err, its, dirs = self._krylov(op, G, b, bnorm, f)
+        x, Cx, gen, its, dirs = self._krylov(op, G, b, bnorm, f)
         self.info["krylov_iterations"] += its
         self.info["krylov_s"] += time.perf_counter() - t0
         if x is None:
@@ -595,7 +602,7 @@ class RecycledGCR:
                 return x, None
             f.stale = True
             return self._solve_one(op, G, b, t)
-        self._remember(x, Cx, err, dirs)
+        self._remember(x, Cx, gen, dirs)
         if self.refactor_after is not None:
             f.stale = its > self.refactor_after
         else:
@@ -642,17 +649,16 @@ class RecycledGCR:
     def _krylov(self, op, G, b, bnorm, f):
         """Minimal residual over recycled + preconditioned directions.
 
-        Returns ``(x, C x, error bound of C x, preconditioned iterations, new directions)``,
-        or ``x = None`` when ``rtol`` was not reached in ``max_krylov`` iterations.  ``C x``
-        is tracked (``y @ CZ``, no product) unless its rounding-error bound -- the recycled
-        pairs' bounds and this combination's own, ``|y| . (E + eps |CZ|)`` -- exceeds
-        ``_TRACK_RTOL |C x|``; then it is formed (``info["exact_products"]``).
+        Returns ``(x, C x, generations, preconditioned iterations, new directions)``, or
+        ``x = None`` when ``rtol`` was not reached in ``max_krylov`` iterations.  ``C x`` is
+        tracked (``y @ CZ``, no product) and checked (:meth:`_tracked_ok`); it is formed
+        when the check fails (``info["exact_products"]``).
         """
         C, D = op.C, op.D
         tol = self.rtol * bnorm
         rec = self.solutions + self.directions
-        # bounds on the rounding error of each recycled C z (2-norm; a direction's: formed)
-        rec_err = self._solution_errors + [_EPS * float(np.linalg.norm(cz)) for _, cz in self.directions]
+        # generations of tracking behind each recycled C z (a direction's was formed: 0)
+        rec_age = self._solution_ages + [0] * len(self.directions)
         max_its = self._max_its(op)
         m = len(rec) + max_its
         n, ne = b.size, C.shape[0]
@@ -661,7 +667,7 @@ class RecycledGCR:
         Q = np.empty((m, n))  # row j: orthonormal basis of A span(Z)
         R = np.zeros((m, m))
         g = np.zeros(m)
-        E = np.zeros(m)  # bound on the rounding error of CZ[j]
+        age = np.zeros(m, dtype=np.int64)  # generations of tracking behind CZ[j]
         k = 0
         r = b.copy()
         if rec:
@@ -676,7 +682,7 @@ class RecycledGCR:
             sel = piv[:k]
             Z[:k] = Zr[sel] / scale[sel, None]
             CZ[:k] = CZr[sel] / scale[sel, None]
-            E[:k] = np.asarray(rec_err)[sel] / scale[sel]
+            age[:k] = np.asarray(rec_age, dtype=np.int64)[sel]
             Q[:k] = q[:, :k].T
             R[:k, :k] = rr[:k, :k]
             for _ in range(2):  # r = b - Q Q^T b, reorthogonalized
@@ -693,15 +699,15 @@ class RecycledGCR:
                 y = sla.solve_triangular(R[:k, :k], g[:k])
                 x = y @ Z[:k]
                 Cx = y @ CZ[:k]  # tracked: C is linear, so no extra product
-                ay = np.abs(y)
-                gen = float(ay @ E[:k] + _EPS * (ay @ np.linalg.norm(CZ[:k], axis=1)))
-                if not gen <= _TRACK_RTOL * float(np.linalg.norm(Cx)):
+                if not self._tracked_ok(C, x, Cx, age[:k]):
                     # form C x: a tracked one inherits its recycled pairs' rounding, amplified
                     # by the combination, generation after generation (measured: 1e-4
                     # relative after 70 steps of a free indenter, films wrong by 10 %)
                     Cx = C @ x
-                    gen = _EPS * float(np.linalg.norm(Cx))
                     self.info["exact_products"] = self.info.get("exact_products", 0) + 1
+                    gen = 0
+                else:
+                    gen = int(age[:k].max()) + 1
                 rt = b - D @ x - G @ Cx  # the TRUE residual
                 res = float(np.linalg.norm(rt))
                 hist.append(res / bnorm)
@@ -736,12 +742,38 @@ class RecycledGCR:
             hist.append(float(np.linalg.norm(r)) / bnorm)
             self.t_iter = time.perf_counter() - t0
 
-    def _remember(self, x, Cx, err, dirs):
+    def _tracked_ok(self, C, x, Cx, ages) -> bool:
+        """Is the tracked ``C x`` within ``_TRACK_RTOL`` of the true one?
+
+        Freivalds' check: with fixed random probes ``w`` (Gaussian, ``_PROBES`` of them) and
+        ``u = w^T C`` formed once, ``w . (C x)_tracked - u . x = w . e`` for the error ``e``;
+        for a Gaussian ``w`` it is ``|e|`` times a standard normal, so ``|e|`` above the
+        tolerance is caught unless every probe is nearly orthogonal to it.  Two dot products
+        per probe instead of an ``elements x unknowns`` product.  A fast (hierarchical)
+        ``C`` has no transpose here: its ``C x`` is formed every ``_MAX_TRACKED``
+        generations instead.
+        """
+        dense = C.C if isinstance(C, _Leading) else C
+        if not isinstance(dense, np.ndarray):
+            return ages.size == 0 or int(ages.max()) < _MAX_TRACKED
+        n = x.size
+        if self._probe is None or self._probe[1].shape[1] != n:
+            w = np.random.default_rng(20221).standard_normal((_PROBES, dense.shape[0]))
+            u = w @ dense
+            if u.shape[1] != n:  # a switched step: C reads the pressure block only
+                u = np.hstack([u, np.zeros((_PROBES, n - u.shape[1]))])
+            self._probe = (w, u, np.linalg.norm(w, axis=1))
+        w, u, wn = self._probe
+        err = np.abs(w @ Cx - u @ x) / wn  # ~ |e| / sqrt(elements) per probe
+        scale = float(np.linalg.norm(Cx)) / math.sqrt(dense.shape[0])
+        return bool(np.all(err <= _TRACK_RTOL * scale))
+
+    def _remember(self, x, Cx, gen, dirs):
         """Keep the newest solutions and preconditioned directions (with C z) for recycling,
-        and the bound on the rounding error of each solution's tracked ``C x``."""
+        and the generations of tracking behind each solution's ``C x``."""
         if self.recycle <= 0:
             return
         nsol = min(4, self.recycle)
         self.solutions = ([(x, Cx)] + self.solutions)[:nsol]
-        self._solution_errors = ([err] + self._solution_errors)[:nsol]
+        self._solution_ages = ([gen] + self._solution_ages)[:nsol]
         self.directions = (dirs + self.directions)[: max(0, self.recycle - len(self.solutions))]

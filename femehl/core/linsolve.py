@@ -298,9 +298,11 @@ class SwitchedLU:
     """LU of ``M = A P_F - B P_S`` of a :class:`SwitchedOperator`, reused as the set moves.
 
     ``solve([r1; r2])`` solves the switched system: ``p_S = r2_S``, ``v_F = r2_F`` and
-    ``M y = r1 - D[:, S] r2_S`` for ``y = (p_F, v_S)`` (the ``G C`` part of the coupling
-    ``A[:, S] r2_S`` is left out: exact when ``r2_S = 0``, as for every right-hand side of
-    a step, and a preconditioner otherwise).  :meth:`adapt` updates it to a later step
+    ``M y = r1 - A[:, S] r2_S`` for ``y = (p_F, v_S)``, the coupling taken on the entries
+    of ``r2_S`` above 1e-6 of the largest (a recycled direction of an earlier step breaks
+    the new constraints at the few nodes that switched), its ``G C`` part from those
+    columns of a dense ``C`` and left out otherwise: exact when ``r2_S = 0``, as for every
+    right-hand side of a step, and a preconditioner otherwise.  :meth:`adapt` updates it to a later step
     whose set differs in ``k`` nodes by a rank-``k`` Woodbury correction (the changed
     columns, taken from the later step's operator), so the preconditioner stays exact in
     the switched columns while the cavity's edge moves; beyond ``max_changes`` it asks
@@ -354,8 +356,13 @@ class SwitchedLU:
         S = op.switched
         r1, r2 = b[:n], b[n:]
         rhs = r1
-        if np.any(r2[S]):
-            rhs = r1 - op.base.D[:, S] @ r2[S]
+        big = S & (np.abs(r2) > 1e-6 * float(np.abs(b).max()))
+        if big.any():  # the coupling A[:, S] r2_S: exactly on the entries that matter
+            j = np.flatnonzero(big)
+            rhs = r1 - op.base.D[:, j] @ r2[j]
+            C = op.base.C
+            if isinstance(C, np.ndarray):  # dense: the columns' product, ne x len(j)
+                rhs = rhs - op.base.G @ (C[:, j] @ r2[j])
         y = self._solve_M(rhs)
         x = np.empty(2 * n)
         x[:n] = np.where(S, r2, y)

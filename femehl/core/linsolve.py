@@ -260,14 +260,6 @@ class SwitchedOperator:
     def factorize(self, dtype, t):
         return SwitchedLU(self, dtype, t)
 
-    def columns_M(self, idx, dtype):
-        """Columns ``idx`` of ``M = A P_F - B P_S`` (dense)."""
-        out = self.base.columns(idx, dtype)
-        on = self.switched[idx]
-        if on.any():
-            out[:, on] = -self.B[:, idx[on]].toarray()
-        return out
-
 
 class _Leading:
     """``C`` acting on the first ``n`` entries of a ``2n`` vector (or of its columns)."""

@@ -337,9 +337,8 @@ class LaggedStepper:
         op, rhs = self.operator(ctx, scale)
         G = op.G if mem is None else op.G / scale  # the terms' G (op.G carries the scale)
         hc_dot = None
-        ones = np.ones(self.shape.size)
         if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
-            rhs_list = [rhs - G @ shape, G @ ones]
+            rhs_list = [rhs - G @ shape, G @ np.ones(self.shape.size)]
         else:
             hc = mo.hc(t_new)
             rhs_list = [rhs - G @ (hc + shape)]
@@ -365,7 +364,7 @@ class LaggedStepper:
         else:
             ((x, Cp),) = self.solver.solve(system, rhs_list, t_new)
         p, unknowns = x[: self.disc.n], x[self.disc.n :]
-        if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
+        if not (np.all(np.isfinite(x)) and np.isfinite(hc)):  # a condition's unknowns too
             raise SingularSystemError(
                 f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
                 "or ill-conditioned. Try a smaller dt or a finer discretization.",

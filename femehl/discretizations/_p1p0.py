@@ -62,9 +62,10 @@ class GasTransport:
         P = sp.csr_matrix((np.full(b.size, 1.0 / self.nv), (elems, nodes)), shape=(ne, nn))
         K = (X @ P).tocsr()
         self.K = K[free][:, free].tocsr()
+        self._dl = {s: self._pairs(s) for s in (1, -1)}  # (nv, nv, ne) per sign of V
         self.upwind = {s: self._element_upwinding(s)[free][:, free].tocsr() for s in (1, -1)}
-        A = (abs(self._element_upwinding(1)) + abs(self._element_upwinding(-1))).tocsr()
-        self.neighbours = (A[free][:, free] != 0).astype(np.int64).tocsr()  # free-node graph
+        inc = sp.csr_matrix((np.ones(b.size), (nodes, elems)), shape=(nn, ne))
+        self.neighbours = (inc @ inc.T)[free][:, free].astype(bool).astype(np.int64).tocsr()  # mesh graph
 
     def _pairs(self, sign):
         """``delta_ij`` for unit ``|V|`` of each element's node pairs, (nv, nv, ne)."""
@@ -75,7 +76,7 @@ class GasTransport:
         return dl
 
     def _element_upwinding(self, sign):
-        dl = self._pairs(sign)
+        dl = self._dl[sign]
         t = self.t
         nn = self.slot.size
         rows = np.broadcast_to(t[:, None, :], dl.shape).ravel()
@@ -113,7 +114,7 @@ class GasTransport:
         delta = np.zeros(k.shape)
         delta[on] = np.asarray(dbar)[k[on]] - np.broadcast_to(d, k.shape)[on]
         e = np.flatnonzero(on.any(axis=0))  # the elements that touch the set
-        b, D, dl = self.b[:, e], delta[:, e], abs(V) * self._pairs(1 if V > 0 else -1)[:, :, e]
+        b, D, dl = self.b[:, e], delta[:, e], abs(V) * self._dl[1 if V > 0 else -1][:, :, e]
         # F_ij = V (b_i D_j - b_j D_i)/nv - dl_ij (D_j - D_i), summed over j
         F = V * (b * D.sum(axis=0) - D * b.sum(axis=0)) / self.nv
         F -= np.einsum("ije,je->ie", dl, D) - dl.sum(axis=1) * D

@@ -28,7 +28,7 @@ Solvers are registered in :data:`LINEAR_SOLVERS` by name:
     fast operator: every 8 generations).  The LU is refreshed by cost balancing: when
     the preconditioned iterations of the last solve cost more than the average cost per solve since the last
     factorization (factorization included), or when ``c_0 = a0/dt`` changed by more than
-    10 %.  ``refactor_after=n`` instead refreshes when a solve needed more than ``n``
+    a factor of 2 (:data:`KEY_CHANGE`).  ``refactor_after=n`` instead refreshes when a solve needed more than ``n``
     preconditioned iterations.  With the *fast* operator (:mod:`femehl.hmatrix`, ``C``
     never formed) the products ``C z`` are hierarchical and the preconditioner is the
     sparse LU (SuperLU, in a METIS nested-dissection order) of ``D + G C_near``,
@@ -487,6 +487,16 @@ class DirectSolver:
         return out
 
 
+#: refresh the preconditioner when ``c_0 = a0/dt`` changed by more than this fraction of
+#: the new ``c_0`` (1: a factor of 2 either way).  Smaller changes are left to the cost
+#: balancing: an adaptive run's ``dt`` drifts by a few % a step, and at 0.1 the paper case
+#: (fitted level 0.5, 11,472 elements, adaptive BDF2 at tol 3.1e-4) refreshed 74 times in
+#: 753 steps, 93 s of its 164 s; at 1 it refreshed 25 times (35 s of 115 s) for 865
+#: preconditioned iterations instead of 690; with no such rule (cost balancing alone) 20
+#: times, but 940 iterations and 121 s.  A fixed-dt run is unaffected (83 s either way).
+KEY_CHANGE = 1.0
+
+
 @dataclass
 class _Factor:
     lu: object  # the preconditioner: DenseLU, SwitchedLU or PermutedLU (``.solve(r)``)
@@ -579,7 +589,7 @@ class RecycledGCR:
         if bnorm == 0.0:
             return np.zeros_like(b), None
         f = self.factor
-        fresh = f is None or f.stale or abs(f.key - op.key) > 0.1 * op.key
+        fresh = f is None or f.stale or abs(f.key - op.key) > KEY_CHANGE * op.key
         if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
             fresh = not f.lu.adapt(op)
         if fresh:

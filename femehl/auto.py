@@ -32,7 +32,8 @@ an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
 accepted when it is at least the third and its estimate is <= tol.  A level whose cells
 would exceed ``max_elements`` (default 25,000, chosen when the dense influence matrix,
 about 3 GB there, was the only operator; with the fast operator it is a cost budget,
-and a caller may raise it, e.g. ``max_elements=200_000``) is not run: the last run is
+and a caller may raise it, e.g. ``max_elements=200_000``; 100,000 on a substrate whose
+operators are all sparse, :data:`LOCAL_MAX_ELEMENTS`) is not run: the last run is
 returned with ``info["auto"]["reached"] = False`` and a logging warning.  The companion
 of the returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
 fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
@@ -80,6 +81,8 @@ __all__ = [
     "register_ladder",
     "QUANTITIES",
     "MAX_ELEMENTS",
+    "LOCAL_MAX_ELEMENTS",
+    "cell_budget",
     "time_tolerance",
 ]
 
@@ -91,6 +94,12 @@ QUANTITIES = ("load", "film_center", "film_min")
 ORDER = 2
 #: levels whose discretization would have more cells than this are not run
 MAX_ELEMENTS = 25_000
+#: ... on a substrate whose operators are all sparse (``substrate.local``: Winkler,
+#: rigid): a step there costs a sparse LU, not dense products, so the same cost buys
+#: more cells.  Measured on the Winkler scene of ``benchmarks/auto.py`` (adaptive BDF2):
+#: 22 ms per step at 11,458 cells, MEASURED_46K at 45,800; a dense step at 25,000 cells
+#: costs about 900 ms.
+LOCAL_MAX_ELEMENTS = 100_000
 #: time tolerance of the run at level 1: ``tol_t = TAU1 * level**2``
 TAU1 = 1.25e-3
 #: bounds of the time tolerance
@@ -366,6 +375,18 @@ def _next_level(level: float, err: float, tol: float) -> float:
     return level / min(hi, max(lo, ratio))
 
 
+def cell_budget(scene, max_elements: int | None = None) -> int:
+    """The automatic mode's cell budget: ``max_elements``, or by default
+    :data:`LOCAL_MAX_ELEMENTS` when the scene's substrate has sparse operators only
+    (``substrate.local``) and :data:`MAX_ELEMENTS` otherwise."""
+    if max_elements is None:
+        local = getattr(getattr(scene, "substrate", None), "local", False)
+        return LOCAL_MAX_ELEMENTS if local else MAX_ELEMENTS
+    if isinstance(max_elements, bool) or not isinstance(max_elements, int) or max_elements < 1:
+        raise SceneError(f"max_elements must be a positive integer (cells), got {max_elements!r}.")
+    return max_elements
+
+
 def solve_to_tolerance(
     scene,
     *,
@@ -373,7 +394,7 @@ def solve_to_tolerance(
     tol: float = 1e-2,
     method: str | None = None,
     store_every: int = 1,
-    max_elements: int = MAX_ELEMENTS,
+    max_elements: int | None = None,
     level: float = LEVEL0,
     runner=None,
     **options,
@@ -384,9 +405,10 @@ def solve_to_tolerance(
     (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
     ``reached``, ``levels``, ``elements``, ``steps``, ``rejected_steps``, ``tol_t`` and
     ``wall`` of every run, and the largest estimated ``total``, ``space`` and ``time``
-    errors.  ``level`` is the first (coarsest) level; ``options`` go to
-    :func:`femehl.solve` (not the discretization's, nor ``tol``, ``dt_max``); a
-    ``callback`` is called with the states of every run.
+    errors.  ``level`` is the first (coarsest) level; ``max_elements`` the cell budget
+    (default :data:`MAX_ELEMENTS`, or :data:`LOCAL_MAX_ELEMENTS` on a substrate with
+    ``local = True``); ``options`` go to :func:`femehl.solve` (not the discretization's,
+    nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run.
     """
     from .api import _registry
 
@@ -401,6 +423,7 @@ def solve_to_tolerance(
     if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
         raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
     ladder = LADDERS[method]
+    max_elements = cell_budget(scene, max_elements)
     for key in ("dt_max", "dt", *ladder.keys):
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")

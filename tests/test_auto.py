@@ -18,6 +18,7 @@ against tol.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import pathlib
@@ -247,3 +248,23 @@ def test_a_closing_confirmed_by_two_levels_is_raised():
     # a step floor with a film that is not thin: not confirmed, refine on
     again = _closing_confirmed(earlier, _closed(2.312, (-1.22, 0.129), "step floor", 5e-3, 0.01), 0.5, 3.0)
     assert again.level == 0.5
+
+
+def test_cell_budget_follows_the_substrate():
+    """Sparse-only substrates (Winkler, rigid, a viscoelastic Winkler) get the larger budget;
+    an explicit budget is kept; a bad one is refused by name."""
+    from femehl.auto import LOCAL_MAX_ELEMENTS, MAX_ELEMENTS, cell_budget
+
+    paper = femehl.presets.paper_sphere()
+    assert cell_budget(paper) == MAX_ELEMENTS
+    for sub in (
+        femehl.Winkler(0.25),
+        femehl.Rigid(),
+        femehl.Viscoelastic(2.0, 1.0, elastic=femehl.Winkler(1.0)),
+    ):
+        assert cell_budget(dataclasses.replace(paper, substrate=sub)) == LOCAL_MAX_ELEMENTS
+    assert cell_budget(dataclasses.replace(paper, substrate=femehl.Viscoelastic(2.0, 1.0))) == MAX_ELEMENTS
+    assert cell_budget(paper, 7) == 7
+    for bad in (0, -3, 2.5, True, "many"):
+        with pytest.raises(femehl.SceneError, match="max_elements must be a positive integer"):
+            cell_budget(paper, bad)

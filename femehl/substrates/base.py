@@ -18,7 +18,12 @@ def register_substrate(cls):
 
 @runtime_checkable
 class Substrate(Protocol):
-    """What the stepper needs from a substrate: ``w = -C p`` on film points and elsewhere."""
+    """What the stepper needs from a substrate: ``w = -C p`` on film points and elsewhere.
+
+    A substrate whose operators are all sparse (each point deflects under its own
+    pressure only: Winkler, rigid) may say so with a class attribute ``local = True``;
+    the automatic mode then allows finer meshes (:data:`femehl.auto.LOCAL_MAX_ELEMENTS`).
+    """
 
     kind: str
 

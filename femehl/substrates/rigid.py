@@ -18,6 +18,8 @@ class Rigid:
     """Rigid substrate: w = 0, no elastic operator at all."""
 
     kind = "rigid"
+    #: every operator is sparse (none at all): see :data:`femehl.auto.LOCAL_MAX_ELEMENTS`
+    local = True
 
     def compliance_operator(self, disc):
         return sp.csr_matrix((disc.film_points.shape[0], disc.n))

@@ -111,6 +111,11 @@ class Viscoelastic:
     #: per-step figures of its runs (summary.csv, Result): the sliding energy budget
     columns = ENERGETICS_COLUMNS
 
+    @property
+    def local(self) -> bool:
+        """Sparse operators only when the relaxing solid's are (a Winkler foundation)."""
+        return bool(getattr(self.elastic, "local", False))
+
     def __post_init__(self):
         G0 = check_positive("unrelaxed modulus G0", self.G0, "Give G0 in units of G.")
         Gi = check_positive("relaxed modulus G_inf", self.G_inf, "Give G_inf in units of G.")

@@ -17,6 +17,8 @@ class Winkler:
 
     k: float = 1.0
     kind = "winkler"
+    #: every operator is sparse (no dense influence matrix): see :data:`femehl.auto.LOCAL_MAX_ELEMENTS`
+    local = True
 
     def __post_init__(self):
         object.__setattr__(self, "k", check_positive("Winkler stiffness k", self.k))

@@ -44,8 +44,9 @@ HAND_LEVELS_PAPER = (0.5,)
 HAND_DT = (0.02, 0.01)
 #: the paper case also on the mesh ladder graded for it (the settings of `femehl bench accuracy`)
 HAND_LADDER = {"paper": ("coarse", "medium", "fine")}
-#: the automatic runs' budget of cells (femehl.auto.MAX_ELEMENTS is 25,000)
-MAX_CELLS = 25_000
+#: the automatic runs' budget of cells: femehl's default (femehl.auto.cell_budget: 25,000,
+#: or 100,000 on a substrate with sparse operators only)
+MAX_CELLS = None
 
 
 def _scenes():
@@ -107,7 +108,40 @@ def run_in_subprocess(spec: dict, cap: float | None = None) -> dict:
         return dict(spec, status=f"crashed: {tail[0]}", wall_s=time.perf_counter() - t)
     rec = json.loads(p.stdout.strip().splitlines()[-1])
     rec["loadavg"] = os.getloadavg()
+    rec.update(_provenance())
     return rec
+
+
+def _provenance() -> dict:
+    """When and on which commit a run was made (the table mixes runs of several sessions)."""
+    out = {"date": time.strftime("%Y-%m-%d", time.gmtime())}
+    try:
+        git = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True, text=True, timeout=10
+        )
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", "../femehl"],
+            cwd=HERE,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        )
+        if git.returncode == 0:
+            out["commit"] = git.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return out
+
+
+def _when(records: list) -> str:
+    """Which runs were made when: one line per (date, commit)."""
+    groups: dict = {}
+    for r in records:
+        key = (r.get("date", "before 2026-12-02"), r.get("commit", "not recorded"))
+        groups.setdefault(key, set()).add(f"{r['scene']} ({r['kind']})")
+    return "\n".join(
+        f"- {d}, commit {c}: " + ", ".join(sorted(names)) for (d, c), names in sorted(groups.items())
+    )
 
 
 # ---- errors against the reference ------------------------------------------------------
@@ -188,7 +222,7 @@ def cheapest(hand: list, r: dict, ref, limit: float) -> str:
     h = min(ok, key=lambda h: h["wall_s"])
     ratio = r["wall_s"] / h["wall_s"]
     where = f"mesh {h['mesh']}" if "mesh" in h else f"level {h['level']:g}"
-    return f"{where}, dt {h['dt']:g}: {h['wall_s']:.1f} s (auto {ratio:.2g}x)"
+    return f"{where}, dt {h['dt']:g}: {h['wall_s']:.1f} s (auto {ratio:.3g}x)"
 
 
 def compact(records: list, refs: dict) -> str:
@@ -288,6 +322,7 @@ def analyze(records: list, refs: dict) -> str:
             "reported minimum includes the origin and the nodes).",
         ]
     lines += ["", "Scenes: " + ", ".join(f"{k} (t_end {v[1]:g})" for k, v in scenes.items()), ""]
+    lines += ["## When the runs were made", "", _when(records), ""]
     _plot(points)
     return "\n".join(lines) + "\n"
 

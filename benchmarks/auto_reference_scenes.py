@@ -81,9 +81,10 @@ SIG = 10  # significant digits kept in the JSON
 #: observed order.
 LEVEL_OVERRIDES = {
     "winkler": (
-        (0.5, 0.5 / 1.4),
+        (0.25, 0.25 / 1.4),
         "Winkler: the substrate operator is sparse (local), so finer meshes are cheap (no dense "
-        "operator); one level finer than the default, and three levels for the observed order",
+        "operator); two levels finer than the default (the automatic mode's budget on a local "
+        "substrate reaches level 0.25), and three levels for the observed order",
     ),
 }
 

@@ -96,9 +96,9 @@ ORDER = 2
 MAX_ELEMENTS = 25_000
 #: ... on a substrate whose operators are all sparse (``substrate.local``: Winkler,
 #: rigid): a step there costs a sparse LU, not dense products, so the same cost buys
-#: more cells.  Measured on the Winkler scene of ``benchmarks/auto.py`` (adaptive BDF2):
-#: 22 ms per step at 11,458 cells, MEASURED_46K at 45,800; a dense step at 25,000 cells
-#: costs about 900 ms.
+#: more cells.  Measured on the Winkler scene of ``benchmarks/auto.py`` (adaptive BDF2,
+#: another run beside it): 29 ms per step at 11,458 cells, 183 ms at 45,182; a dense
+#: step at 27,640 cells costs about 900 ms (``benchmarks/fast_operator.md``).
 LOCAL_MAX_ELEMENTS = 100_000
 #: time tolerance of the run at level 1: ``tol_t = TAU1 * level**2``
 TAU1 = 1.25e-3

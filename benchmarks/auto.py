@@ -44,8 +44,9 @@ HAND_LEVELS_PAPER = (0.5,)
 HAND_DT = (0.02, 0.01)
 #: the paper case also on the mesh ladder graded for it (the settings of `femehl bench accuracy`)
 HAND_LADDER = {"paper": ("coarse", "medium", "fine")}
-#: the automatic runs' budget of cells: femehl's default (femehl.auto.cell_budget: 25,000,
-#: or 100,000 on a substrate with sparse operators only)
+#: the automatic runs' budget of cells: femehl's default (femehl.auto.cell_budget: 100,000
+#: on a half space (fast operator) or a substrate with sparse operators only; 25,000 on a
+#: dense-only one)
 MAX_CELLS = None
 
 

@@ -31,9 +31,10 @@ an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
 ``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
 accepted when it is at least the third and its estimate is <= tol.  A level whose cells
 would exceed ``max_elements`` (default 25,000, chosen when the dense influence matrix,
-about 3 GB there, was the only operator; with the fast operator it is a cost budget,
-and a caller may raise it, e.g. ``max_elements=200_000``; 100,000 on a substrate whose
-operators are all sparse, :data:`LOCAL_MAX_ELEMENTS`) is not run: the last run is
+about 3 GB there, was the only operator; it stays the budget of a substrate whose
+operator is dense only, a layer), 100,000 on a substrate with the fast hierarchical
+operator (the half space, :data:`FAST_MAX_ELEMENTS`: a cost budget, a caller may raise
+it) or whose operators are all sparse (:data:`LOCAL_MAX_ELEMENTS`) is not run: the last run is
 returned with ``info["auto"]["reached"] = False`` and a logging warning.  The companion
 of the returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
 fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
@@ -82,6 +83,7 @@ __all__ = [
     "QUANTITIES",
     "MAX_ELEMENTS",
     "LOCAL_MAX_ELEMENTS",
+    "FAST_MAX_ELEMENTS",
     "cell_budget",
     "time_tolerance",
 ]
@@ -92,8 +94,15 @@ logger = logging.getLogger("femehl")
 QUANTITIES = ("load", "film_center", "film_min")
 #: observed/expected order of the space error in h and of the BDF2 global time error in tol_t
 ORDER = 2
-#: levels whose discretization would have more cells than this are not run
+#: levels whose discretization would have more cells than this are not run, on a
+#: substrate whose elastic operator is dense only (``operators = ("dense",)``: a layer)
 MAX_ELEMENTS = 25_000
+#: ... on a substrate with the fast hierarchical operator (the half space, compressible
+#: or not; a viscoelastic one relaxing it), used by the FE method from 12,000 elements
+#: on: its memory grows like the cells (17 kB each) and a step costs about 1.3 s at
+#: 89,000 cells (``benchmarks/fast_operator.md``), so this is a cost budget, not a
+#: memory limit
+FAST_MAX_ELEMENTS = 100_000
 #: ... on a substrate whose operators are all sparse (``substrate.local``: Winkler,
 #: rigid): a step there costs a sparse LU, not dense products, so the same cost buys
 #: more cells.  Measured on the Winkler scene of ``benchmarks/auto.py`` (adaptive BDF2,
@@ -378,10 +387,16 @@ def _next_level(level: float, err: float, tol: float) -> float:
 def cell_budget(scene, max_elements: int | None = None) -> int:
     """The automatic mode's cell budget: ``max_elements``, or by default
     :data:`LOCAL_MAX_ELEMENTS` when the scene's substrate has sparse operators only
-    (``substrate.local``) and :data:`MAX_ELEMENTS` otherwise."""
+    (``substrate.local``), :data:`FAST_MAX_ELEMENTS` when it has the fast hierarchical
+    operator (``"fast"`` in ``substrate.operators``, the default) and
+    :data:`MAX_ELEMENTS` when its operator is dense only (a layer)."""
     if max_elements is None:
-        local = getattr(getattr(scene, "substrate", None), "local", False)
-        return LOCAL_MAX_ELEMENTS if local else MAX_ELEMENTS
+        sub = getattr(scene, "substrate", None)
+        if getattr(sub, "local", False):
+            return LOCAL_MAX_ELEMENTS
+        if sub is not None and "fast" in getattr(sub, "operators", ("fast",)):
+            return FAST_MAX_ELEMENTS
+        return MAX_ELEMENTS
     if isinstance(max_elements, bool) or not isinstance(max_elements, int) or max_elements < 1:
         raise SceneError(f"max_elements must be a positive integer (cells), got {max_elements!r}.")
     return max_elements
@@ -406,8 +421,8 @@ def solve_to_tolerance(
     ``reached``, ``levels``, ``elements``, ``steps``, ``rejected_steps``, ``tol_t`` and
     ``wall`` of every run, and the largest estimated ``total``, ``space`` and ``time``
     errors.  ``level`` is the first (coarsest) level; ``max_elements`` the cell budget
-    (default :data:`MAX_ELEMENTS`, or :data:`LOCAL_MAX_ELEMENTS` on a substrate with
-    ``local = True``); ``options`` go to :func:`femehl.solve` (not the discretization's,
+    (default: :func:`cell_budget` of the scene's substrate); ``options`` go to
+    :func:`femehl.solve` (not the discretization's,
     nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run.
     """
     from .api import _registry

@@ -251,19 +251,25 @@ def test_a_closing_confirmed_by_two_levels_is_raised():
 
 
 def test_cell_budget_follows_the_substrate():
-    """Sparse-only substrates (Winkler, rigid, a viscoelastic Winkler) get the larger budget;
-    an explicit budget is kept; a bad one is refused by name."""
-    from femehl.auto import LOCAL_MAX_ELEMENTS, MAX_ELEMENTS, cell_budget
+    """Sparse-only substrates (Winkler, rigid, a viscoelastic Winkler) and those with the
+    fast operator (half spaces, a viscoelastic half space) get the larger budgets, a
+    dense-only one (a layer, a viscoelastic layer) the dense budget; an explicit budget is
+    kept; a bad one is refused by name."""
+    from femehl.auto import FAST_MAX_ELEMENTS, LOCAL_MAX_ELEMENTS, MAX_ELEMENTS, cell_budget
 
     paper = femehl.presets.paper_sphere()
-    assert cell_budget(paper) == MAX_ELEMENTS
+    assert MAX_ELEMENTS < FAST_MAX_ELEMENTS
+    assert cell_budget(paper) == FAST_MAX_ELEMENTS
+    for sub in (femehl.HalfSpace(nu=0.3), femehl.Viscoelastic(2.0, 1.0)):
+        assert cell_budget(dataclasses.replace(paper, substrate=sub)) == FAST_MAX_ELEMENTS
+    for sub in (femehl.Layer(0.5), femehl.Viscoelastic(2.0, 1.0, elastic=femehl.Layer(0.5))):
+        assert cell_budget(dataclasses.replace(paper, substrate=sub)) == MAX_ELEMENTS
     for sub in (
         femehl.Winkler(0.25),
         femehl.Rigid(),
         femehl.Viscoelastic(2.0, 1.0, elastic=femehl.Winkler(1.0)),
     ):
         assert cell_budget(dataclasses.replace(paper, substrate=sub)) == LOCAL_MAX_ELEMENTS
-    assert cell_budget(dataclasses.replace(paper, substrate=femehl.Viscoelastic(2.0, 1.0))) == MAX_ELEMENTS
     assert cell_budget(paper, 7) == 7
     for bad in (0, -3, 2.5, True, "many"):
         with pytest.raises(femehl.SceneError, match="max_elements must be a positive integer"):

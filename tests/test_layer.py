@@ -366,6 +366,10 @@ def test_refused_combinations(tmp_path):
     with pytest.raises(SceneError, match="operator='dense'"):
         FEDisc(sc, mesh="coarse", operator="fast")
     assert FEDisc(sc, mesh="coarse", operator="auto").operator == "dense"
+    # a viscoelastic layer relaxes the layer's dense operator: no fast one either
+    visco = dataclasses.replace(sc, substrate=femehl.Viscoelastic(2.0, 1.0, elastic=femehl.Layer(0.5)))
+    with pytest.raises(SceneError, match="operator='dense'"):
+        FEDisc(visco, mesh="coarse", operator="fast")
     # line contact takes a Winkler foundation only
     with pytest.raises(SceneFileError, match="winkler"):
         scene_from_mapping(

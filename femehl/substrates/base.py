@@ -23,6 +23,9 @@ class Substrate(Protocol):
     A substrate whose operators are all sparse (each point deflects under its own
     pressure only: Winkler, rigid) may say so with a class attribute ``local = True``;
     the automatic mode then allows finer meshes (:data:`femehl.auto.LOCAL_MAX_ELEMENTS`).
+    One whose FE operator is dense only (no hierarchical ``"fast"`` one, as a layer's radial
+    kernel) says so with ``operators = ("dense",)``: ``operator="fast"`` is then refused and
+    the automatic mode keeps to :data:`femehl.auto.MAX_ELEMENTS`.
     """
 
     kind: str

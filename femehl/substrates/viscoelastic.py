@@ -116,6 +116,11 @@ class Viscoelastic:
         """Sparse operators only when the relaxing solid's are (a Winkler foundation)."""
         return bool(getattr(self.elastic, "local", False))
 
+    @property
+    def operators(self) -> tuple:
+        """The FE elastic operators of the relaxing solid (a layer: dense only)."""
+        return tuple(getattr(self.elastic, "operators", ("dense", "fast", "auto")))
+
     def __post_init__(self):
         G0 = check_positive("unrelaxed modulus G0", self.G0, "Give G0 in units of G.")
         Gi = check_positive("relaxed modulus G_inf", self.G_inf, "Give G_inf in units of G.")

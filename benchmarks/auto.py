@@ -31,7 +31,7 @@ import subprocess
 import sys
 import time
 
-from _machine import machine
+from _machine import machine, provenance
 
 HERE = pathlib.Path(__file__).resolve().parent
 RUNS = HERE / "auto_runs.jsonl"
@@ -109,40 +109,8 @@ def run_in_subprocess(spec: dict, cap: float | None = None) -> dict:
         return dict(spec, status=f"crashed: {tail[0]}", wall_s=time.perf_counter() - t)
     rec = json.loads(p.stdout.strip().splitlines()[-1])
     rec["loadavg"] = os.getloadavg()
-    rec.update(_provenance())
+    rec.update(provenance())
     return rec
-
-
-def _provenance() -> dict:
-    """When and on which commit a run was made (the table mixes runs of several sessions)."""
-    out = {"date": time.strftime("%Y-%m-%d", time.gmtime()), "cpu": _cpu()}
-    try:
-        git = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True, text=True, timeout=10
-        )
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--", "../femehl"],
-            cwd=HERE,
-            capture_output=True,
-            text=True,
-            timeout=10,
-        )
-        if git.returncode == 0:
-            out["commit"] = git.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
-    except (OSError, subprocess.SubprocessError):
-        pass
-    return out
-
-
-def _cpu() -> str:
-    """The CPU model (/proc/cpuinfo), as the tables' machine line gives it."""
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown"
 
 
 def _when(records: list) -> str:

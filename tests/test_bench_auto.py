@@ -1,0 +1,77 @@
+"""The comparison of ``femehl bench auto`` (benchmarks/auto.py) on series with a known answer.
+
+An adaptive run lands on the motion's breakpoint (t = 1) and restarts with steps far below
+the fixed-step reference's 0.005 there, while the quantity relaxes within 0.002 (as the
+load does after the paper's ramp stops).  Both series below sample the SAME function
+exactly, so every "true error" the comparison reports is its own interpolation error.
+"""
+
+import importlib.util
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def bench():
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    spec = importlib.util.spec_from_file_location("femehl_bench_auto", ROOT / "benchmarks" / "auto.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def q(t):
+    """0.3 + 0.3 t^2 up to the breakpoint t = 1, then a relaxation by 0.003 in 0.002."""
+    t = np.asarray(t, dtype=float)
+    after = 0.6 - 0.003 * (1.0 - np.exp(-(t - 1.0) / 0.002)) - 0.05 * (t - 1.0)
+    return np.where(t <= 1.0, 0.3 + 0.3 * t**2, after)
+
+
+def test_an_adaptive_run_is_compared_where_it_is_resolved(bench):
+    # adaptive: from 1e-4 growing by 1.2 per step up to 0.03 before the breakpoint, then
+    # from 1e-5 growing by 1.15 up to 0.01 (the Winkler run's steps were 3e-4 to 8e-4 over
+    # t - 1 in [0.003, 0.01])
+    before = np.r_[0.0, np.cumsum(np.minimum(1e-4 * 1.2 ** np.arange(200), 0.03))]
+    before = before[before < 1.0]
+    after = 1.0 + np.cumsum(np.minimum(1e-5 * 1.15 ** np.arange(200), 0.01))
+    t = np.r_[before, 1.0, after[after < 1.5], 1.5]
+    tr = np.round(np.arange(0.0, 1.5 + 1e-9, 0.005), 12)
+    series = {name: q(t).tolist() for name in bench.QUANTITIES}
+    rec = {"kind": "auto", "scene": "sphere_b20_sliding", "tol": 1e-2, "t": t.tolist(), **series}
+    rec["estimate"] = {name: np.full(t.size, 1e-3).tolist() for name in bench.QUANTITIES}
+    ref = {
+        "t": tr.tolist(),
+        "reference": {name: q(tr).tolist() for name in bench.QUANTITIES},
+        "t_from": 0.04,
+        "uncertainty": {name: 0.0 for name in bench.QUANTITIES},
+    }
+    errors = bench.true_errors(rec, ref)
+    # its own interpolation error only: PCHIP on steps of 0.03 before the breakpoint, within
+    # a fifth of linear interpolation's bound there (h^2 q'' / 8 / q = 1.1e-4; measured 8e-6)
+    assert max(e["true"] for e in errors.values()) < 2e-5
+    # the artefact it replaces: the reference linearly interpolated at the run's times right
+    # after the breakpoint is off by about a quarter of the relaxation (0.003 / 0.6)
+    keep = t > 1.0
+    naive = np.abs(np.interp(t[keep], tr, q(tr)) - q(t[keep])) / q(t[keep])
+    assert naive.max() > 1e-3
+
+
+def test_a_fixed_step_run_is_compared_at_its_own_times(bench):
+    tr = np.round(np.arange(0.0, 1.5 + 1e-9, 0.005), 12)
+    t = np.round(np.arange(0.0, 1.5 + 1e-9, 0.02), 12)
+    values = q(t) * (1.0 + 2e-3)  # 0.2 % off everywhere
+    rec = {"kind": "hand", "scene": "sphere_b20_sliding", "t": t.tolist()}
+    rec.update({name: values.tolist() for name in bench.QUANTITIES})
+    ref = {
+        "t": tr.tolist(),
+        "reference": {name: q(tr).tolist() for name in bench.QUANTITIES},
+        "t_from": 0.04,
+        "uncertainty": {},
+    }
+    for e in bench.true_errors(rec, ref).values():
+        assert e["true"] == pytest.approx(2e-3, rel=1e-9)

@@ -164,13 +164,13 @@ def independent(r: dict, ref) -> bool:
     return bool(ref and levels) and levels[-1] > 1.1 * ref["finest_level"]
 
 
-def _compared(rec: dict, ref: dict, q: str):
+def _compared(rec: dict, ref: dict, q: str, breakpoints: tuple):
     """The compared times and the record's, the reference's and the estimate's values there.
 
     A fixed-step record (the hand-tuned grid: dt 0.01 or 0.02, multiples of the reference's
     0.005) is compared at its own times, where the reference has steps of its own.  An
     adaptive record is compared at the reference's times, its series interpolated there
-    (PCHIP between the breakpoints of the scene's motion, where it lands and restarts; its
+    (PCHIP between ``breakpoints``, the scene's motion's, where it lands and restarts; its
     estimate, a running maximum, linearly): after a breakpoint it takes steps far below the
     reference's (the load relaxes within about 0.002 after the ramp stops at t = 1), and
     the linear interpolation of the reference between its steps there, not either run, made
@@ -195,8 +195,7 @@ def _compared(rec: dict, ref: dict, q: str):
     _, first = np.unique(t, return_index=True)  # the last state at a repeated time
     last = np.r_[first[1:] - 1, t.size - 1]
     ts, vs = t[last], np.asarray(rec[q])[last]
-    factory, _ = _scenes()[rec["scene"]]
-    cuts = [b for b in factory().motion.breakpoints if ts[0] < b < ts[-1]]
+    cuts = [b for b in breakpoints if ts[0] < b < ts[-1]]
     edges = [ts[0], *cuts, ts[-1]]
     qv = np.empty(tc.size)
     for a, b in zip(edges[:-1], edges[1:], strict=True):
@@ -210,9 +209,11 @@ def true_errors(rec: dict, ref: dict) -> dict:
     """Per quantity: max relative error over the compared times and the share where est >= true/2."""
     import numpy as np
 
+    factory, _ = _scenes()[rec["scene"]]
+    breakpoints = factory().motion.breakpoints
     out = {}
     for q in QUANTITIES:
-        _, qv, qr, est = _compared(rec, ref, q)
+        _, qv, qr, est = _compared(rec, ref, q, breakpoints)
         scale = np.maximum(np.abs(qr), 0.1 if q == "load" else 0.0)
         true = np.abs(qv - qr) / scale
         entry = {"true": float(np.max(true)) if true.size else float("nan")}

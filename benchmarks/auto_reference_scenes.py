@@ -118,19 +118,13 @@ def _r(v: float) -> float:
 
 def machine() -> dict:
     """nproc, the cpu model (/proc/cpuinfo) and the load average now."""
-    model = platform.processor() or platform.machine()
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    from _machine import cpu
+
     try:
         load = [float(v) for v in pathlib.Path("/proc/loadavg").read_text().split()[:3]]
     except OSError:
         load = None
-    return {"nproc": os.cpu_count(), "cpu": model, "loadavg": load, "python": platform.python_version()}
+    return {"nproc": os.cpu_count(), "cpu": cpu(), "loadavg": load, "python": platform.python_version()}
 
 
 # ---------------------------------------------------------------------------
@@ -270,9 +264,9 @@ def _scale(q: str, v):
 
 
 def _series_errors(entry: dict, q: str):
-    """Relative Richardson correction ``u`` (at the times ``ta``) and time error ``e`` (at
-    the times ``tt`` of the ``2 DT`` run) of quantity ``q``, t = 0 left out; and the
-    reference series ``qx``."""
+    """``(tu, u, te, e, qx)`` of quantity ``q``: the relative Richardson correction ``u``
+    at the times ``tu`` and the time error ``e`` at the times ``te`` of the ``2 DT`` run,
+    t = 0 left out; and the reference series ``qx`` (every time)."""
     import numpy as np
 
     ra, rb, rt = (entry["runs"][k] for k in ("a", "b", "a_dt2"))
@@ -314,26 +308,24 @@ def reference(entry: dict) -> None:
 
     ra, rb = entry["runs"]["a"], entry["runs"]["b"]
     ratio = ra["level"] / rb["level"]
-    ta = np.asarray(ra["t"])
     ref = {"t": rb["t"], "ratio": ratio}
     unc, terr = {}, {}
     diag = {}
     rc = entry["runs"].get("coarse")
     for q in QUANTITIES:
-        _, u, tt1, e, qx = _series_errors(entry, q)
-        tt = np.r_[0.0, tt1]
+        tu, u, te, e, qx = _series_errors(entry, q)  # t > 0
         qa, qb = np.asarray(ra[q]), np.asarray(rb[q])
         ref[q] = [_r(v) for v in qx]
         unc[q] = float(np.max(u))
         terr[q] = float(np.max(e))
-        iu, ie = int(np.argmax(u)) + 1, int(np.argmax(e)) + 1
+        iu, ie = int(np.argmax(u)), int(np.argmax(e))
         diag[q] = {
-            "uncertainty_t": _r(ta[iu]),
+            "uncertainty_t": _r(tu[iu]),
             "uncertainty_end": _r(u[-1]),
-            "uncertainty_t_ge_1": _r(np.max(u[ta[1:] >= 1.0 - 1e-9])),
-            "time_error_t": _r(tt[ie]),
+            "uncertainty_t_ge_1": _r(np.max(u[tu >= 1.0 - 1e-9])),
+            "time_error_t": _r(te[ie]),
             "time_error_end": _r(e[-1]),
-            "time_error_t_ge_1": _r(np.max(e[tt[1:] >= 1.0 - 1e-9])),
+            "time_error_t_ge_1": _r(np.max(e[te >= 1.0 - 1e-9])),
         }
         if rc is not None:  # three levels: the observed order, and the coarser pair's correction
             qc = np.asarray(rc[q])
@@ -342,7 +334,7 @@ def reference(entry: dict) -> None:
             qx2 = qa + (qa - qc) / (ratio**ORDER - 1.0)
             diag[q].update(
                 observed_order_end=_r(p[-1]),
-                observed_order_at_max=_r(p[iu]),
+                observed_order_at_max=_r(p[iu + 1]),
                 coarse_pair_levels=[rc["level"], ra["level"]],
                 coarse_pair_uncertainty=_r(np.max((np.abs(qx2 - qa) / _scale(q, qx2))[1:])),
                 coarse_pair_vs_reference=_r(np.max((np.abs(qx2 - qx) / _scale(q, qx))[1:])),

@@ -25,6 +25,8 @@ import subprocess
 import sys
 import time
 
+from _machine import provenance
+
 HERE = pathlib.Path(__file__).resolve().parent
 RUNS = HERE / "stress_auto.jsonl"
 BETAS = (2.0, 20.0, 200.0, 2000.0, 20000.0)
@@ -64,15 +66,9 @@ def worker(spec: dict) -> dict:
     return out
 
 
-def _provenance(cap: float) -> dict:
-    """The cap, the date, the commit and the CPU of a case's run (what its row stands on)."""
-    from _machine import provenance
-
-    return dict(provenance(), cap_s=cap)
-
-
 def run_case(spec: dict, cap: float) -> dict:
-    return dict(_run_case(spec, cap), **_provenance(cap))
+    """One case in a subprocess, with the cap, date, commit and CPU it ran under."""
+    return dict(_run_case(spec, cap), **provenance(), cap_s=cap)
 
 
 def _run_case(spec: dict, cap: float) -> dict:

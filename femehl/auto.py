@@ -30,13 +30,12 @@ Levels 4, 2 (pilots: cheap, their fields never written), then each next level ai
 an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
 ``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
 accepted when it is at least the third and its estimate is <= tol.  A level whose cells
-would exceed ``max_elements`` (default 25,000, chosen when the dense influence matrix,
-about 3 GB there, was the only operator; it stays the budget of a substrate whose
-operator is dense only, a layer), 100,000 on a substrate with the fast hierarchical
-operator (the half space, :data:`FAST_MAX_ELEMENTS`: a cost budget, a caller may raise
-it) or whose operators are all sparse (:data:`LOCAL_MAX_ELEMENTS`) is not run: the last run is
-returned with ``info["auto"]["reached"] = False`` and a logging warning.  The companion
-of the returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
+would exceed ``max_elements`` (:func:`cell_budget`: 100,000 on a substrate with the fast
+hierarchical operator or with sparse operators only, a cost budget a caller may raise;
+25,000 on one whose operator is dense only, a layer, where the dense influence matrix
+of about 3 GB is the limit) is not run: the last run is returned with
+``info["auto"]["reached"] = False`` and a logging warning.  The companion of the
+returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
 fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
 itself; the pilots less than that.
 
@@ -391,10 +390,12 @@ def cell_budget(scene, max_elements: int | None = None) -> int:
     operator (``"fast"`` in ``substrate.operators``, the default) and
     :data:`MAX_ELEMENTS` when its operator is dense only (a layer)."""
     if max_elements is None:
-        sub = getattr(scene, "substrate", None)
+        from .substrates.base import substrate_operators
+
+        sub = getattr(scene, "substrate", None)  # None: a line contact's own foundation
         if getattr(sub, "local", False):
             return LOCAL_MAX_ELEMENTS
-        if sub is not None and "fast" in getattr(sub, "operators", ("fast",)):
+        if sub is not None and "fast" in substrate_operators(sub):
             return FAST_MAX_ELEMENTS
         return MAX_ELEMENTS
     if isinstance(max_elements, bool) or not isinstance(max_elements, int) or max_elements < 1:

@@ -36,6 +36,7 @@ from ..kernels import (
     sparse_radial_influence,
     triangle_influence,
 )
+from ..substrates.base import OPERATORS, substrate_operators
 from ..validation import check_operator_tol
 from . import register_method
 from ._p1p0 import P1P0
@@ -47,7 +48,6 @@ __all__ = ["FEDisc"]
 FITTED = "fitted"
 
 #: the elastic operators an FE disk can build (``operator=``); "auto" picks by size
-OPERATORS = ("dense", "fast", "auto")
 
 #: "auto" uses the fast operator from this many elements on (or when the dense one does
 #: not fit in memory): the measured crossover of the time per step, benchmarks/fast_operator.md
@@ -161,7 +161,7 @@ class FEDisc(P1P0):
         from ..fe.mesh import check_mesh_memory, dense_fits
 
         sub = self.scene.substrate
-        allowed = getattr(sub, "operators", OPERATORS)
+        allowed = substrate_operators(sub)
         if operator == "fast" and "fast" not in allowed:
             raise SceneError(
                 f"the fast hierarchical operator approximates the half space's 1/r kernel only; "

@@ -4,10 +4,19 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
-__all__ = ["Substrate", "SUBSTRATES", "register_substrate"]
+__all__ = ["Substrate", "SUBSTRATES", "register_substrate", "OPERATORS", "substrate_operators"]
 
 #: kind -> substrate class (the names of ``[substrate] kind`` in scene files)
 SUBSTRATES: dict[str, type] = {}
+
+#: the FE elastic operators (``operator=``): a substrate builds all of them unless its
+#: ``operators`` says otherwise
+OPERATORS = ("dense", "fast", "auto")
+
+
+def substrate_operators(substrate) -> tuple:
+    """The FE elastic operators ``substrate`` builds: its ``operators``, or all of them."""
+    return tuple(getattr(substrate, "operators", OPERATORS))
 
 
 def register_substrate(cls):

@@ -74,7 +74,7 @@ import scipy.sparse as sp
 from ..errors import SceneError
 from ..tribology import ENERGETICS_COLUMNS
 from ..validation import check_positive
-from .base import Substrate, register_substrate
+from .base import Substrate, register_substrate, substrate_operators
 from .halfspace import HalfSpace
 
 __all__ = ["Viscoelastic", "CreepMemory", "StepMemory"]
@@ -119,7 +119,7 @@ class Viscoelastic:
     @property
     def operators(self) -> tuple:
         """The FE elastic operators of the relaxing solid (a layer: dense only)."""
-        return tuple(getattr(self.elastic, "operators", ("dense", "fast", "auto")))
+        return substrate_operators(self.elastic)
 
     def __post_init__(self):
         G0 = check_positive("unrelaxed modulus G0", self.G0, "Give G0 in units of G.")

@@ -395,7 +395,9 @@ def main(argv=None) -> None:
     ap.add_argument("--resume", action="store_true", help="skip runs already in auto_runs.jsonl")
     ap.add_argument("--analyze-only", action="store_true")
     ap.add_argument("--cap", type=float, default=1200.0, help="wall-time cap per run, seconds")
-    ap.add_argument("--redo", help="comma-separated scene names whose automatic runs are run again")
+    ap.add_argument(
+        "--redo", help="comma-separated scene names whose automatic runs at --tol are run again"
+    )
     args = ap.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(json.loads(args.worker))))
@@ -429,12 +431,14 @@ def main(argv=None) -> None:
         if not args.resume:
             records, done = [], set()
             RUNS.write_text("")
-        if args.redo:
-            redo = set(args.redo.split(","))
-            records = [r for r in records if not (r["kind"] == "auto" and r["scene"] in redo)]
-            done = {
-                d for d in done if not any(f'"scene": "{n}"' in d and '"kind": "auto"' in d for n in redo)
-            }
+        if args.redo:  # the named scenes' automatic runs at the tolerances asked for, not others
+            redo = {(n, float(t)) for n in args.redo.split(",") for t in args.tol.split(",")}
+
+            def redone(r):
+                return r["kind"] == "auto" and (r["scene"], float(r["tol"])) in redo
+
+            records = [r for r in records if not redone(r)]
+            done = {d for d in done if not redone(json.loads(d))}
             RUNS.write_text("".join(json.dumps(r) + "\n" for r in records))
         for spec in specs:
             if json.dumps(spec, sort_keys=True) in done:

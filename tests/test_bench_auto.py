@@ -75,3 +75,32 @@ def test_a_fixed_step_run_is_compared_at_its_own_times(bench):
     }
     for e in bench.true_errors(rec, ref).values():
         assert e["true"] == pytest.approx(2e-3, rel=1e-9)
+
+
+def test_redo_reruns_only_the_tolerances_asked_for(bench, tmp_path, monkeypatch):
+    # a scene with runs at two tolerances: `--tol 1e-3 --redo s` reruns the 1e-3 run and keeps
+    # the 1e-2 one (it used to drop every automatic run of the scene)
+    import json
+
+    runs = tmp_path / "auto_runs.jsonl"
+    old = [
+        {"kind": "auto", "scene": "punch", "tol": 0.01, "status": "ok", "mark": "kept"},
+        {"kind": "auto", "scene": "punch", "tol": 0.001, "status": "ok", "mark": "old"},
+        {"kind": "hand", "scene": "punch", "level": 1.0, "dt": 0.01, "status": "ok", "mark": "kept"},
+    ]
+    runs.write_text("".join(json.dumps(r) + "\n" for r in old))
+    ran = []
+
+    def fake_run(spec, cap=None):
+        ran.append(spec)
+        return dict(spec, status="ok", mark="new")
+
+    monkeypatch.setattr(bench, "RUNS", runs)
+    monkeypatch.setattr(bench, "REFERENCE", tmp_path / "none.json")
+    monkeypatch.setattr(bench, "HERE", tmp_path)
+    monkeypatch.setattr(bench, "run_in_subprocess", fake_run)
+    monkeypatch.setattr(bench, "analyze", lambda records, refs: "")
+    bench.main(["--tol", "1e-3", "--only", "punch", "--no-hand", "--resume", "--redo", "punch"])
+    assert ran == [{"kind": "auto", "scene": "punch", "tol": 0.001}]
+    marks = sorted((r["kind"], r.get("tol"), r["mark"]) for r in map(json.loads, runs.read_text().splitlines()))
+    assert marks == [("auto", 0.001, "new"), ("auto", 0.01, "kept"), ("hand", None, "kept")]

@@ -395,9 +395,7 @@ def main(argv=None) -> None:
     ap.add_argument("--resume", action="store_true", help="skip runs already in auto_runs.jsonl")
     ap.add_argument("--analyze-only", action="store_true")
     ap.add_argument("--cap", type=float, default=1200.0, help="wall-time cap per run, seconds")
-    ap.add_argument(
-        "--redo", help="comma-separated scene names whose automatic runs at --tol are run again"
-    )
+    ap.add_argument("--redo", help="comma-separated scene names whose automatic runs at --tol are run again")
     args = ap.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(json.loads(args.worker))))

@@ -420,24 +420,15 @@ def main(argv=None) -> None:
                 for m in HAND_LADDER.get(n, ())
                 for dt in HAND_DT
             ]
-        done = {
-            json.dumps(
-                {k: r[k] for k in r if k in ("kind", "scene", "tol", "level", "mesh", "dt")}, sort_keys=True
-            )
-            for r in records
-        }
         if not args.resume:
-            records, done = [], set()
+            records = []
             RUNS.write_text("")
         if args.redo:  # the named scenes' automatic runs at the tolerances asked for, not others
             redo = {(n, float(t)) for n in args.redo.split(",") for t in args.tol.split(",")}
-
-            def redone(r):
-                return r["kind"] == "auto" and (r["scene"], float(r["tol"])) in redo
-
-            records = [r for r in records if not redone(r)]
-            done = {d for d in done if not redone(json.loads(d))}
+            records = [r for r in records if not (r["kind"] == "auto" and (r["scene"], r["tol"]) in redo)]
             RUNS.write_text("".join(json.dumps(r) + "\n" for r in records))
+        keys = ("kind", "scene", "tol", "level", "mesh", "dt")
+        done = {json.dumps({k: r[k] for k in r if k in keys}, sort_keys=True) for r in records}
         for spec in specs:
             if json.dumps(spec, sort_keys=True) in done:
                 continue

@@ -47,8 +47,6 @@ __all__ = ["FEDisc"]
 #: the mesh name that asks for a mesh fitted to the scene (:func:`femehl.fe.fitted.fitted_disk`)
 FITTED = "fitted"
 
-#: the elastic operators an FE disk can build (``operator=``); "auto" picks by size
-
 #: "auto" uses the fast operator from this many elements on (or when the dense one does
 #: not fit in memory): the measured crossover of the time per step, benchmarks/fast_operator.md
 FAST_CROSSOVER = 12_000

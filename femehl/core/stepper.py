@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from ..errors import SceneError, SingularSystemError
 from ..stepping import State, get_scheme
-from .linsolve import StepOperator, make_linear_solver
+from .linsolve import StepOperator, film_rtol_scale, make_linear_solver
 from .terms import StepContext, terms_for
 
 __all__ = ["LaggedStepper"]
@@ -316,6 +316,7 @@ class LaggedStepper:
         free_index = self.disc.free_index
         p_old = state.p[free_index] if cav is None else cav.lagged_pressure(state, free_index)
         its0 = self.solver.info.get("krylov_iterations", 0)
+        self.solver.rtol_scale = film_rtol_scale(state.d, state.w)  # the residual follows the film
         ctx = StepContext(
             t_new=t_new,
             dt=dt,

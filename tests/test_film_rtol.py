@@ -64,7 +64,7 @@ def test_residual_follows_the_film(monkeypatch, direct):
     scales = [film_rtol_scale(s.d, s.w) for s in res.states[:-1]]
     residuals = [s.info["residual"] for s in res.states[1:]]
     assert min(scales) < 1e-2  # the film really is thin against the deflection
-    assert all(r <= 1e-8 * c for r, c in zip(residuals, scales))
+    assert all(r <= 1e-8 * c for r, c in zip(residuals, scales, strict=True))
     assert np.abs(res.film_min / direct.film_min - 1.0).max() < 2e-6
 
 

@@ -41,8 +41,13 @@ def worker(spec: dict) -> dict:
     sys.path.insert(0, str(HERE))
     from stress import horizon, paper_scene
 
+    import logging
+
     import femehl
 
+    # each finished level on stderr: a capped case's record says how far it got
+    logging.basicConfig(stream=sys.stderr, level=logging.WARNING, format="%(message)s")
+    logging.getLogger("femehl").setLevel(logging.INFO)
     scene = paper_scene(spec["beta"], spec["h0"], spec["T"])
     t_end = horizon(spec["T"])
     out = dict(spec, t_end=t_end)
@@ -79,12 +84,26 @@ def _run_case(spec: dict, cap: float) -> dict:
     t0 = time.perf_counter()
     try:
         p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=cap)
-    except subprocess.TimeoutExpired:
-        return dict(spec, status=f"capped at {cap:g} s", wall_s=time.perf_counter() - t0)
+    except subprocess.TimeoutExpired as exc:
+        out = dict(spec, status=f"capped at {cap:g} s", wall_s=time.perf_counter() - t0)
+        levels = _finished_levels(exc.stderr)
+        if levels:
+            out["levels_done"] = levels
+        return out
     if p.returncode != 0:
         tail = (p.stderr.strip().splitlines() or ["?"])[-1]
         return dict(spec, status=f"crashed: {tail}", wall_s=time.perf_counter() - t0)
     return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def _finished_levels(stderr) -> list:
+    """``[[level, cells], ...]`` of the levels a worker finished (its femehl log lines)."""
+    import re
+
+    if isinstance(stderr, bytes):
+        stderr = stderr.decode(errors="replace")
+    pattern = re.compile(r"auto: level ([0-9.eE+-]+) \((\d+) cells")
+    return [[float(m.group(1)), int(m.group(2))] for m in pattern.finditer(stderr or "")]
 
 
 def write_md(records: list, cap: float) -> None:
@@ -110,6 +129,8 @@ def write_md(records: list, cap: float) -> None:
     for r in sorted(records, key=lambda r: (r["beta"], r["h0"], r["T"])):
         a = r.get("auto", {})
         cells = "/".join(map(str, a.get("elements", []))) or str(r.get("cells", ""))
+        if "levels_done" in r:  # a capped case: the levels it finished
+            cells = "/".join(str(n) for _, n in r["levels_done"]) + " finished"
         est = f"{100 * a['total']:.2g} %" if "total" in a else ""
         fmin = f"{r['film_min']:.3g}" if "film_min" in r else ""
         t_reached = f"{r['t_reached']:.3g}" if "t_reached" in r else ""

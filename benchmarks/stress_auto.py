@@ -39,9 +39,9 @@ DEFAULT_CAP = 300.0
 
 def worker(spec: dict) -> dict:
     sys.path.insert(0, str(HERE))
-    from stress import horizon, paper_scene
-
     import logging
+
+    from stress import horizon, paper_scene
 
     import femehl
 

@@ -72,6 +72,7 @@ __all__ = [
     "DirectSolver",
     "RecycledGCR",
     "make_linear_solver",
+    "film_rtol_scale",
 ]
 
 

@@ -464,13 +464,38 @@ class H2Operator:
         return self._near_perm[inv]
 
     # -- application ----------------------------------------------------------------------
+    #: columns per blocked product (a block's moments take n_nodes x p^2 x BLOCK x 8 bytes)
+    BLOCK = 32
+
     def __matmul__(self, u):
         u = np.asarray(u, dtype=float)
-        if u.ndim == 2:
-            return np.column_stack([self @ u[:, k] for k in range(u.shape[1])])
+        if u.ndim == 2:  # columns: the far field blocked (batched matrix products)
+            out = np.empty((self.T.perm.size, u.shape[1]))
+            for s in range(0, u.shape[1], self.BLOCK):
+                ub = u[:, s : s + self.BLOCK]
+                y = self.far_block(ub if self.fold is None else self.fold @ ub)
+                y[self.T.perm] += self._near_perm @ ub
+                out[:, s : s + self.BLOCK] = y
+            return out
         y = self.far(u if self.fold is None else self.fold @ u)
         y[self.T.perm] += self._near_perm @ u
         return y
+
+    def far_block(self, u):
+        """:meth:`far` of the columns of ``u`` (n x k) at once: the same passes, k wide."""
+        p, pp, k = self.p, self.p * self.p, u.shape[1]
+        M = np.asarray(self._P2M @ (self.G @ u)).reshape(self.n_nodes_S, p, p, k)
+        for c, par, wx, wy in self._levels_S:  # M_parent += Wx^T M_child Wy, per column
+            M[par] += np.einsum("nba,nbck,ncd->nadk", wx, M[c], wy, optimize=True)
+        L = np.zeros((self.n_nodes_T, pp * k))
+        Mf = M.reshape(-1, pp, k)
+        for scatter, fs, U, V in self._far_groups:
+            t = np.matmul(U, np.matmul(V, Mf[fs]))  # (blocks, pp, k)
+            L += scatter @ t.reshape(t.shape[0], pp * k)
+        L = L.reshape(self.n_nodes_T, p, p, k)
+        for c, par, wx, wy in reversed(self._levels_T):  # L_child += Wx L_parent Wy^T
+            L[c] += np.einsum("nab,nbck,ndc->nadk", wx, L[par], wy, optimize=True)
+        return np.asarray(self._L2P @ L.reshape(-1, k))
 
     def far(self, u):
         """The interpolated (admissible) part of ``X u`` only."""
@@ -507,6 +532,12 @@ def order_for(tol: float) -> int:
 PRECOND_RADIUS = 4.0
 
 
+#: coarse space of the preconditioner (:mod:`femehl.fe.coarse`): about one coarse node per
+#: COARSE_RATIO free nodes, between COARSE_MIN and COARSE_MAX (``C P`` costs
+#: elements x COARSE_MAX x 4 bytes: 2.4 GB at 1,000,000 elements)
+COARSE_RATIO, COARSE_MIN, COARSE_MAX = 12, 100, 600
+
+
 class FastCompliance:
     """``C = factor * X P`` of a disk mesh with ``X`` as an :class:`H2Operator` (never dense).
 
@@ -518,7 +549,7 @@ class FastCompliance:
 
     is_fast = True
 
-    def __init__(self, disc, tol: float = 1e-6, factor: float = 1.0):
+    def __init__(self, disc, tol: float = 1e-6, factor: float = 1.0, coarse: bool = True):
         tol = check_operator_tol(tol)
         t0 = time.perf_counter()
         ne = disc.nelements
@@ -547,11 +578,33 @@ class FastCompliance:
         self.H.kept = None
         self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ P
         self.shape = (ne, P.shape[1])
+        self._coarse_P = None
+        if coarse:
+            from .fe.coarse import coarse_prolongation
+
+            m = min(COARSE_MAX, max(COARSE_MIN, P.shape[1] // COARSE_RATIO))
+            if P.shape[1] > 2 * COARSE_MIN:
+                self._coarse_P, _ = coarse_prolongation(disc.nodes, disc.mesh.t.T, disc.free, m)
+        self._CP = None
+        if self._coarse_P is not None:  # C P by blocked products (single precision: it
+            t1 = time.perf_counter()  # serves the preconditioner only), part of the set-up
+            self._CP = np.asarray(self @ self._coarse_P.toarray(), dtype=np.float32)
+            self.H.info.update(coarse_nodes=int(self._coarse_P.shape[1]), coarse_s=time.perf_counter() - t1)
         self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
 
     def __imul__(self, factor):
         self.factor *= float(factor)
+        if self._CP is not None:
+            self._CP *= np.float32(factor)
         return self
+
+    @property
+    def coarse(self):
+        """``() -> (P, C P)`` of the preconditioner's coarse space
+        (:mod:`femehl.fe.coarse`, elements x coarse nodes), or None without one."""
+        if self._CP is None:
+            return None
+        return lambda: (self._coarse_P, self._CP)
 
     @property
     def preconditioner(self):
@@ -566,6 +619,8 @@ class FastCompliance:
     @property
     def nbytes(self) -> int:
         n = self.H.nbytes + self._pre.data.nbytes + self._pre.indices.nbytes + self._pre.indptr.nbytes
+        if self._CP is not None:
+            n += self._CP.nbytes + self._coarse_P.data.nbytes + self._coarse_P.indices.nbytes
         return int(n)
 
     def __matmul__(self, z):

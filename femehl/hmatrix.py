@@ -588,7 +588,10 @@ class FastCompliance:
         self._CP = None
         if self._coarse_P is not None:  # C P by blocked products (single precision: it
             t1 = time.perf_counter()  # serves the preconditioner only), part of the set-up
-            self._CP = np.asarray(self @ self._coarse_P.toarray(), dtype=np.float32)
+            P, blk = self._coarse_P.tocsc(), H2Operator.BLOCK
+            self._CP = np.empty((ne, P.shape[1]), dtype=np.float32)
+            for s in range(0, P.shape[1], blk):  # a block of dense columns at a time
+                self._CP[:, s : s + blk] = self @ P[:, s : s + blk].toarray()
             self.H.info.update(coarse_nodes=int(self._coarse_P.shape[1]), coarse_s=time.perf_counter() - t1)
         self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
 

@@ -495,7 +495,8 @@ class TwoLevel:
 
     def solve(self, r):
         y = sla.lu_solve(self.lu, self.P.T @ r)
-        return self.P @ y + self.near.solve(r - self.AP @ y)
+        APy = self.AP @ y.astype(np.float32)  # in single precision: no double copy of AP
+        return self.P @ y + self.near.solve(r - APy)
 
 
 @register_linear_solver("lu")

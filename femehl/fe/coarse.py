@@ -13,8 +13,9 @@ file): a subset of its nodes, spaced ``c`` times the local element size (greedy
 Poisson-disk selection, finest regions first, so the coarse mesh keeps the fine mesh's
 grading), with its rim nodes kept at the same spacing so that the coarse Delaunay
 triangulation covers the domain; ``c`` is chosen for about ``m`` coarse free nodes.
-Coarse rim nodes carry the fine mesh's Dirichlet condition (no column); a fine node the
-coarse triangulation does not cover (rounding on the hull) takes its nearest coarse node.
+Coarse rim nodes carry the fine mesh's Dirichlet condition (no column), and the coarse
+functions vanish on fine nodes outside the coarse triangulation (between a coarse rim
+chord and the rim).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import Delaunay, cKDTree
 
-__all__ = ["coarse_prolongation", "node_sizes"]
+__all__ = ["coarse_prolongation", "node_sizes", "boundary_corners"]
 
 
 def node_sizes(nodes: np.ndarray, tri: np.ndarray) -> np.ndarray:
@@ -38,6 +39,28 @@ def node_sizes(nodes: np.ndarray, tri: np.ndarray) -> np.ndarray:
     np.add.at(total, tri.ravel(), np.repeat(area, 3))
     np.add.at(count, tri.ravel(), 1.0)
     return np.sqrt(total / np.maximum(count, 1.0))
+
+
+def boundary_corners(nodes: np.ndarray, tri: np.ndarray, angle: float = np.radians(20.0)) -> np.ndarray:
+    """Boundary nodes where the boundary turns by more than ``angle`` (a half disk's two
+    ends of the symmetry axis): kept in the coarse mesh, so that it covers the domain."""
+    tri = np.asarray(tri, dtype=np.int64)
+    e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    u, count = np.unique(e, axis=0, return_counts=True)
+    b = u[count == 1]  # boundary edges
+    if b.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    node = np.concatenate([b[:, 0], b[:, 1]])  # (node, boundary neighbour) both ways
+    nbr = np.concatenate([b[:, 1], b[:, 0]])
+    o = np.argsort(node, kind="stable")
+    node, nbr = node[o], nbr[o]
+    k, first, count = np.unique(node, return_index=True, return_counts=True)
+    two = count == 2  # a node on one boundary curve: its two neighbours
+    k, first = k[two], first[two]
+    d1 = nodes[k] - nodes[nbr[first]]
+    d2 = nodes[nbr[first + 1]] - nodes[k]
+    cos = np.einsum("ij,ij->i", d1, d2) / (np.linalg.norm(d1, axis=1) * np.linalg.norm(d2, axis=1))
+    return k[cos < np.cos(angle)]
 
 
 def _select(points: np.ndarray, radius: np.ndarray, order: np.ndarray) -> np.ndarray:
@@ -65,10 +88,13 @@ def coarse_prolongation(nodes: np.ndarray, tri: np.ndarray, free: np.ndarray, m:
     nodes = np.asarray(nodes, dtype=float)
     free = np.asarray(free, dtype=np.int64)
     nn = nodes.shape[0]
-    h = node_sizes(nodes, np.asarray(tri))
+    tri = np.asarray(tri, dtype=np.int64)
+    h = node_sizes(nodes, tri)
     is_free = np.zeros(nn, dtype=bool)
     is_free[free] = True
-    order = np.argsort(h, kind="stable")  # finest first: the grading survives
+    key = h.copy()
+    key[boundary_corners(nodes, tri)] = -1.0  # corners first: always kept
+    order = np.argsort(key, kind="stable")  # then finest first: the grading survives
     rim = order[~is_free[order]]
     inner = order[is_free[order]]
     c = max(2.0, np.sqrt(free.size / max(m, 1)))
@@ -84,7 +110,7 @@ def coarse_prolongation(nodes: np.ndarray, tri: np.ndarray, free: np.ndarray, m:
     col[: keep_in.size] = np.arange(keep_in.size)
     dl = Delaunay(nodes[verts])
     pts = nodes[free]
-    s = dl.find_simplex(pts)
+    s = dl.find_simplex(pts, tol=1e-10)
     rows, cols, vals = [], [], []
     ok = np.flatnonzero(s >= 0)
     if ok.size:
@@ -97,15 +123,9 @@ def coarse_prolongation(nodes: np.ndarray, tri: np.ndarray, free: np.ndarray, m:
         rows.append(np.repeat(ok, 3)[use.ravel()])
         cols.append(cc[use])
         vals.append(bary[use])
-    out = np.flatnonzero(s < 0)
-    if out.size:  # on the hull within rounding: the nearest coarse vertex
-        _, j = cKDTree(nodes[verts]).query(pts[out])
-        cj = col[j]
-        use = cj >= 0
-        rows.append(out[use])
-        cols.append(cj[use])
-        vals.append(np.ones(int(use.sum())))
-    P = sp.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(free.size, keep_in.size)
-    )
+    # a fine node outside the coarse triangulation (between a coarse rim chord and the
+    # rim) gets a zero row: the coarse functions vanish there, as at the coarse rim
+    if rows:
+        rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    P = sp.csr_matrix((vals, (rows, cols)), shape=(free.size, keep_in.size))
     return P, keep_in

@@ -182,7 +182,18 @@ def _run(args: list[str], timeout: float) -> dict | None:
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
     if p.returncode or not lines:
         return {"args": args, "error": (p.stderr or p.stdout)[-600:]}
-    return json.loads(lines[-1])
+    return {**json.loads(lines[-1]), "commit": _head()}
+
+
+def _head() -> str | None:
+    """The short commit of the checkout this benchmark runs from (None outside git)."""
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True, text=True, timeout=10
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None
 
 
 def fit_exponent(n, y):
@@ -190,6 +201,12 @@ def fit_exponent(n, y):
 
     ln, ly = np.log(np.asarray(n, float)), np.log(np.asarray(y, float))
     return float(np.polyfit(ln, ly, 1)[0])
+
+
+def _commits(rows: list[dict]) -> str:
+    """The sentence " Commits: a, b." of the rows that record theirs (empty if none does)."""
+    done = sorted({r["commit"] for r in rows if r.get("commit")})
+    return f" Commits: {', '.join(done)}." if done else ""
 
 
 def write(
@@ -209,7 +226,7 @@ def write(
         "Paper sphere (beta = 200), fitted half-disk meshes, BDF2 at dt = 0.01; ms per step is the "
         "mean over steps 5 to the last of the first `steps` steps (the contact forming), Krylov "
         "iterations per step likewise; peak RSS is the whole process (mesh, operators, solver). "
-        "Each case ran in its own process, one after another.",
+        "Each case ran in its own process, one after another." + _commits(rows),
         "",
         "| operator | elements | set-up s | ms / step | Krylov / step (max) | operator bytes / element "
         "| peak RSS GiB | steps |",
@@ -304,6 +321,8 @@ def write(
             f"{tex['steps']} | "
             f"{tex['wall_s'] / 60:.1f} min to t = {tex['t_end']:g} |"
         )
+        if tex.get("note"):
+            lines += ["", tex["note"]]
         lines.append("")
     path_md.write_text("\n".join(lines) + "\n")
     try:

@@ -578,36 +578,33 @@ class FastCompliance:
         self.H.kept = None
         self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ P
         self.shape = (ne, P.shape[1])
-        self._coarse_P = None
-        if coarse:
-            from .fe.coarse import coarse_prolongation
-
+        #: ``(P, C P)`` of the preconditioner's coarse space (:mod:`femehl.fe.coarse`; C P
+        #: elements x coarse nodes, single precision: it serves the preconditioner only),
+        #: None on meshes too small for one
+        self.coarse = None
+        if coarse and P.shape[1] > 2 * COARSE_MIN:
+            t1 = time.perf_counter()
             m = min(COARSE_MAX, max(COARSE_MIN, P.shape[1] // COARSE_RATIO))
-            if P.shape[1] > 2 * COARSE_MIN:
-                self._coarse_P, _ = coarse_prolongation(disc.nodes, disc.mesh.t.T, disc.free, m)
-        self._CP = None
-        if self._coarse_P is not None:  # C P by blocked products (single precision: it
-            t1 = time.perf_counter()  # serves the preconditioner only), part of the set-up
-            P, blk = self._coarse_P.tocsc(), H2Operator.BLOCK
-            self._CP = np.empty((ne, P.shape[1]), dtype=np.float32)
-            for s in range(0, P.shape[1], blk):  # a block of dense columns at a time
-                self._CP[:, s : s + blk] = self @ P[:, s : s + blk].toarray()
-            self.H.info.update(coarse_nodes=int(self._coarse_P.shape[1]), coarse_s=time.perf_counter() - t1)
+            self.coarse = self._coarse_space(disc, m)
+            self.H.info.update(coarse_nodes=int(self.coarse[0].shape[1]), coarse_s=time.perf_counter() - t1)
         self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
+
+    def _coarse_space(self, disc, m: int) -> tuple:
+        """``(P, C P)`` of about ``m`` coarse nodes, ``C P`` by blocked products (set-up)."""
+        from .fe.coarse import coarse_prolongation
+
+        Pc, _ = coarse_prolongation(disc.mesh, disc.areas, disc.free, m)
+        Pcsc, blk = Pc.tocsc(), H2Operator.BLOCK
+        CP = np.empty((self.shape[0], Pc.shape[1]), dtype=np.float32)
+        for s in range(0, Pc.shape[1], blk):  # a block of dense columns at a time
+            CP[:, s : s + blk] = self @ Pcsc[:, s : s + blk].toarray()
+        return Pc, CP
 
     def __imul__(self, factor):
         self.factor *= float(factor)
-        if self._CP is not None:
-            self._CP *= np.float32(factor)
+        if self.coarse is not None:
+            self.coarse[1][...] *= np.float32(factor)
         return self
-
-    @property
-    def coarse(self):
-        """``() -> (P, C P)`` of the preconditioner's coarse space
-        (:mod:`femehl.fe.coarse`, elements x coarse nodes), or None without one."""
-        if self._CP is None:
-            return None
-        return lambda: (self._coarse_P, self._CP)
 
     @property
     def preconditioner(self):
@@ -622,8 +619,9 @@ class FastCompliance:
     @property
     def nbytes(self) -> int:
         n = self.H.nbytes + self._pre.data.nbytes + self._pre.indices.nbytes + self._pre.indptr.nbytes
-        if self._CP is not None:
-            n += self._CP.nbytes + self._coarse_P.data.nbytes + self._coarse_P.indices.nbytes
+        if self.coarse is not None:
+            Pc, CP = self.coarse
+            n += CP.nbytes + Pc.data.nbytes + Pc.indices.nbytes + Pc.indptr.nbytes
         return int(n)
 
     def __matmul__(self, z):

@@ -40,7 +40,7 @@ def disc(sphere):
 
 @pytest.mark.parametrize("m", [60, 200])
 def test_coarse_space_interpolates_linear_functions(disc, m):
-    P, verts = coarse_prolongation(disc.nodes, disc.mesh.t.T, disc.free, m)
+    P, verts = coarse_prolongation(disc.mesh, disc.areas, disc.free, m)
     assert P.shape == (disc.n, verts.size)
     assert abs(verts.size - m) <= 0.25 * m
     assert np.all(np.isin(verts, disc.free))  # coarse free vertices are fine free nodes
@@ -55,8 +55,8 @@ def test_coarse_space_interpolates_linear_functions(disc, m):
 
 def test_coarse_space_keeps_the_grading(disc):
     """Coarse vertices are denser where the fitted mesh is fine (the contact band)."""
-    _, verts = coarse_prolongation(disc.nodes, disc.mesh.t.T, disc.free, 150)
-    h = node_sizes(disc.nodes, disc.mesh.t.T)
+    _, verts = coarse_prolongation(disc.mesh, disc.areas, disc.free, 150)
+    h = node_sizes(disc.mesh, disc.areas)
     fine = h <= np.quantile(h[disc.free], 0.25)
     coarse = h >= np.quantile(h[disc.free], 0.75)
     # coarse vertices per area, in the finest and the coarsest quarter of the mesh
@@ -77,10 +77,10 @@ def test_coarse_product_follows_the_compliance_factor(sphere):
     """``C *= k`` (a compressible substrate) scales the stored ``C P`` too."""
     d = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.41), operator="dense")
     C = FastCompliance(d)
-    P, CP = C.coarse()
+    P, CP = C.coarse
     before = CP.copy()
     C *= 1.4
-    P2, CP2 = C.coarse()
+    P2, CP2 = C.coarse
     assert np.allclose(CP2, 1.4 * before, rtol=1e-6)
     ref = C @ P[:, :5].toarray()
     assert np.max(np.abs(CP2[:, :5] - ref)) <= 1e-6 * np.max(np.abs(ref))  # float32 storage
@@ -117,7 +117,7 @@ def test_coarse_correction_cuts_iterations(sphere):
         A = lambda z, op=op: op.D @ z + op.G @ (op.C @ z)  # noqa: E731
         An = op.near_matrix()
         near = PermutedLU(An, nested_dissection(An), t)
-        two = TwoLevel(near, op, *op.C.coarse(), t)
+        two = TwoLevel(near, *op.coarse_system(), t)
         n_near = _gcr_iterations(A, near.solve, b)
         n_two = _gcr_iterations(A, two.solve, b)
         assert n_two <= 0.75 * n_near, (t, n_near, n_two)

@@ -115,6 +115,19 @@ class StepOperator:
         """Sparse CSC ``D + sum_i c_i F_i C_near`` of a fast operator: the preconditioner."""
         return self._sparse_sum()
 
+    def coarse_system(self):
+        """``(P, A P)`` on the coarse space of a fast ``C`` (``C.coarse = (P, C P)``), or
+        None without one.  ``A P = D P + G (C P)``: sparse work, single precision (it
+        serves the preconditioner, :class:`TwoLevel`)."""
+        coarse = getattr(self.C, "coarse", None)
+        if coarse is None:
+            return None
+        P, CP = coarse
+        AP = np.asarray(self.G.astype(np.float32) @ CP)  # no double copy of C P
+        DP = (self.D @ P).tocoo()
+        np.add.at(AP, (DP.row, DP.col), DP.data.astype(np.float32))
+        return P, AP
+
     def _sparse_sum(self):
         """``D + sum_i c_i (F C)_i`` with the stored sparse products, as CSC."""
         A = self.D
@@ -265,6 +278,11 @@ class SwitchedOperator:
 
     def near_matrix(self):
         return sp.csc_matrix(self._stack(self.base.near_matrix()))
+
+    def coarse_system(self):
+        """None: the coarse space is one of pressures, and the switched unknowns are not
+        all pressures (its preconditioner is the near-field LU alone)."""
+        return None
 
     def matrix(self, dtype=np.float64):
         """The sparse ``2n x 2n`` matrix (a sparse ``C``); a dense one is never formed."""
@@ -469,24 +487,21 @@ class TwoLevel:
     """Near-field LU plus a coarse Galerkin correction: ``solve(r)`` approximates ``A^-1 r``.
 
     With ``P`` (n x m) a coarse P1 space (:func:`femehl.fe.coarse.coarse_prolongation`)
-    and ``AP = A P = D P + G (C P)`` (``C P`` formed once per operator, sparse work per
-    refresh), the coarse solve comes first and the near-field LU ``N`` smooths what is
-    left: ``y = (P^T A P)^-1 P^T r``, ``z = P y + N^-1 (r - AP y)``.  No product with
-    ``C`` per application (``A P y`` is ``AP @ y``).  The near-field LU misses the smooth
-    far field of the 1/r kernel; the coarse space carries it.  Measured on the paper
-    sphere (11,450 elements, fresh solves to 1e-9 without recycling): 13-19 iterations
-    with ``N`` alone, 5-7 with ``m`` = 400 coarse nodes; the coarse-after and the additive
-    forms did worse (8-10, 14-21).
+    and ``AP = A P = D P + G (C P)`` (:meth:`StepOperator.coarse_system`: ``C P`` formed
+    once at set-up, sparse work per refresh), the coarse solve comes first and the
+    near-field LU ``N`` smooths what is left: ``y = (P^T A P)^-1 P^T r``,
+    ``z = P y + N^-1 (r - AP y)``.  No product with ``C`` per application (``A P y`` is
+    ``AP @ y``).  The near-field LU misses the smooth far field of the 1/r kernel; the
+    coarse space carries it.  Measured on the paper sphere (11,450 elements, fresh
+    solves to 1e-9 without recycling): 13-19 iterations with ``N`` alone, 5-7 with
+    ``m`` = 400 coarse nodes; the coarse-after and the additive forms did worse (8-10,
+    14-21).
     """
 
-    def __init__(self, near, op, P, CP, t):
+    def __init__(self, near, P, AP, t):
         self.near = near
         self.P = P
-        # single precision (a preconditioner): G (C P) without a double copy of C P
-        AP = np.asarray(op.G.astype(np.float32) @ CP)
-        DP = (op.D @ P).tocoo()
-        np.add.at(AP, (DP.row, DP.col), DP.data.astype(np.float32))
-        self.AP = AP  # read once per application
+        self.AP = AP  # single precision: read once per application
         Ac = np.asarray(P.T @ AP, dtype=float)
         try:
             self.lu = sla.lu_factor(Ac, check_finite=True)
@@ -734,17 +749,15 @@ class RecycledGCR:
         """The preconditioner: single-precision LU of the current A, or with the fast
         operator the sparse LU of its near-field part."""
         self.factor = None  # free the old factor before forming the new A
-        coarse = None
-        if op.fast and isinstance(op, StepOperator) and getattr(op.C, "coarse", None) is not None:
-            coarse = op.C.coarse()  # formed once (set-up, not a refresh's cost)
         t0 = time.perf_counter()
         if op.fast:
             A = op.near_matrix()
             if self._order is None or self._order[0] != (A.shape, A.nnz):  # the pattern is fixed
                 self._order = ((A.shape, A.nnz), nested_dissection(A))
             lu = PermutedLU(A, self._order[1], t)
+            coarse = op.coarse_system()
             if coarse is not None:  # the smooth far field: a coarse Galerkin correction
-                lu = TwoLevel(lu, op, *coarse, t)
+                lu = TwoLevel(lu, *coarse, t)
         else:
             lu = op.factorize(self.precond_dtype, t)
         cost = time.perf_counter() - t0

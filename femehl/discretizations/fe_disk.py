@@ -49,8 +49,8 @@ FITTED = "fitted"
 
 #: "auto" uses the fast operator from this many elements on (or when the dense one does
 #: not fit in memory): the measured crossover of the whole paper case (set-up and steps,
-#: BDF2 at dt = 0.01, one BLAS thread): dense / fast 16.0 / 20.5 s at 5,766 elements,
-#: 29.3 / 28.0 s at 7,998, 56 / 40 s at 11,450 (benchmarks/fast_operator.md)
+#: BDF2 at dt = 0.01, one BLAS thread): dense / fast 14 / 16 s at 5,766 elements,
+#: 27 / 23 s at 7,998, 56 / 40 s at 11,450 (benchmarks/fast_operator.md, agreement table)
 FAST_CROSSOVER = 8_000
 
 

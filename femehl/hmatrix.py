@@ -469,31 +469,25 @@ class H2Operator:
     BLOCK = 32
 
     def __matmul__(self, u):
-        if sp.issparse(u):  # sparse columns (a coarse space): the near field's product stays sparse
-            return self._sparse_columns(u)
+        if sp.issparse(u) or np.ndim(u) == 2:
+            return self._columns(u)
         u = np.asarray(u, dtype=float)
-        if u.ndim == 2:  # columns: the far field blocked (batched matrix products)
-            out = np.empty((self.T.perm.size, u.shape[1]))
-            for s in range(0, u.shape[1], self.BLOCK):
-                ub = u[:, s : s + self.BLOCK]
-                y = self.far_block(ub if self.fold is None else self.fold @ ub)
-                y[self.T.perm] += self._near_perm @ ub
-                out[:, s : s + self.BLOCK] = y
-            return out
         y = self.far(u if self.fold is None else self.fold @ u)
         y[self.T.perm] += self._near_perm @ u
         return y
 
-    def _sparse_columns(self, u):
-        """``X @ u`` for a sparse ``u`` (n x k, e.g. coarse hat functions), blocked like
-        :meth:`__matmul__`: the near product sparse, the far field skipping the source
-        clusters where a block of columns vanishes (:meth:`far_block`)."""
-        u = sp.csc_matrix(u, dtype=float)
+    def _columns(self, u):
+        """``X @ u`` of the columns of ``u`` (n x k), :data:`BLOCK` at a time through
+        :meth:`far_block`.  A sparse ``u`` (coarse hat functions) stays sparse in the near
+        product, and its blocks leave the far blocks of vanishing sources skipped."""
+        sparse = sp.issparse(u)
+        u = sp.csc_matrix(u, dtype=float) if sparse else np.asarray(u, dtype=float)
+        dense = (lambda a: a.toarray()) if sparse else np.asarray
         out = np.empty((self.T.perm.size, u.shape[1]))
         for s in range(0, u.shape[1], self.BLOCK):
             ub = u[:, s : s + self.BLOCK]
-            y = self.far_block((ub if self.fold is None else self.fold @ ub).toarray())
-            y[self.T.perm] += (self._near_perm @ ub).toarray()
+            y = self.far_block(dense(ub if self.fold is None else self.fold @ ub))
+            y[self.T.perm] += dense(self._near_perm @ ub)
             out[:, s : s + self.BLOCK] = y
         return out
 

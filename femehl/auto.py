@@ -33,8 +33,11 @@ accepted when it is at least the third and its estimate is <= tol.  A level whos
 would exceed ``max_elements`` (:func:`cell_budget`: 100,000 on a substrate with the fast
 hierarchical operator or with sparse operators only, a cost budget a caller may raise;
 25,000 on one whose operator is dense only, a layer, where the dense influence matrix
-of about 3 GB is the limit) is not run: the last run is returned with
-``info["auto"]["reached"] = False`` and a logging warning.  The companion of the
+of about 3 GB is the limit) is not run.  Instead the finest level within the budget is
+run, if it is at least :data:`BUDGET_RATIO` = 1.2 times finer than the last run
+(:func:`budget_level`), and the sequence stops there: when it does not reach ``tol``
+(or no such level exists) the last run is returned with ``info["auto"]["reached"] =
+False`` and a logging warning.  The companion of the
 returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
 fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
 itself; the pilots less than that.
@@ -84,6 +87,7 @@ __all__ = [
     "LOCAL_MAX_ELEMENTS",
     "FAST_MAX_ELEMENTS",
     "cell_budget",
+    "budget_level",
     "time_tolerance",
 ]
 
@@ -119,6 +123,11 @@ MIN_RUNS = 3
 SAFETY = 0.6
 #: ... with a ratio to the previous level in this range
 RATIO_RANGE = (math.sqrt(2.0), 2.0)
+#: the level the estimate asks for would exceed the cell budget: the finest level within
+#: it is still run if it is at least this ratio finer than the last run (its pair estimate
+#: divides the difference by ratio**2 - 1 >= 0.44), found to about 1 % in cells
+BUDGET_RATIO = 1.2
+BUDGET_BISECTIONS = 8
 
 
 def time_tolerance(level: float) -> float:
@@ -383,6 +392,25 @@ def _next_level(level: float, err: float, tol: float) -> float:
     return level / min(hi, max(lo, ratio))
 
 
+def budget_level(ladder: Ladder, scene, t_end: float, previous: float, wanted: float, max_elements: int):
+    """The finest level whose cells fit ``max_elements``, between ``wanted`` (the level the
+    estimate asks for, over the budget) and ``previous`` (the last run's level), if it is
+    at least :data:`BUDGET_RATIO` finer than ``previous``; else None.
+
+    By bisection in ``log(level)`` on :attr:`Ladder.cells` (nothing is built): the budget
+    still buys one more run, whose pair estimate (ratio >= BUDGET_RATIO to the last run)
+    is the one returned.
+    """
+    fits = lambda lv: ladder.cells(scene, t_end, lv) <= max_elements  # noqa: E731
+    lo, hi = math.log(previous / BUDGET_RATIO), math.log(wanted)
+    if hi >= lo or not fits(math.exp(lo)):
+        return None
+    for _ in range(BUDGET_BISECTIONS):  # lo fits, hi does not
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fits(math.exp(mid)) else (lo, mid)
+    return math.exp(lo)
+
+
 def cell_budget(scene, max_elements: int | None = None) -> int:
     """The automatic mode's cell budget: ``max_elements``, or by default
     :data:`LOCAL_MAX_ELEMENTS` when the scene's substrate has sparse operators only
@@ -444,14 +472,26 @@ def solve_to_tolerance(
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
     runs, est, reached, err = [], None, False, math.nan
-    fine, failed = None, None
+    fine, failed, last = None, None, False
     while True:
         ne = ladder.cells(scene, t_end, level)
         if (runs or failed) and ne > max_elements:
-            logger.info("auto: level %.3g would have ~%.0f cells > %d: stop", level, ne, max_elements)
-            if failed is not None and not runs:
-                raise failed  # no level within the budget got through
-            break
+            fit = None
+            if runs and not last:
+                fit = budget_level(ladder, scene, t_end, runs[-1].info["level"], level, max_elements)
+            if fit is None:
+                logger.info("auto: level %.3g would have ~%.0f cells > %d: stop", level, ne, max_elements)
+                if failed is not None and not runs:
+                    raise failed  # no level within the budget got through
+                break
+            logger.info(
+                "auto: level %.3g would have ~%.0f cells > %d: last run at level %.3g, the finest within it",
+                level,
+                ne,
+                max_elements,
+                fit,
+            )
+            level, last = fit, True
         candidate = len(runs) >= MIN_RUNS - 1
         previous = runs[-1] if candidate else None
         try:
@@ -473,6 +513,8 @@ def solve_to_tolerance(
         runs.append(res)
         if len(runs) >= MIN_RUNS and err <= tol:
             reached = True
+            break
+        if last:
             break
         level = _next_level(level, err, tol) if len(runs) >= 2 else level / 2.0
     return _finish(fine, est, runs, tol, reached)

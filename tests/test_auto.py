@@ -183,6 +183,33 @@ def test_budget_stops_with_a_warning(caplog):
         res.uncertainty("load", 0.05)
 
 
+def test_budget_buys_one_last_finer_run(caplog):
+    """The level the estimate asks for exceeds the budget: the finest level within it is run
+    (at least BUDGET_RATIO finer than the last), then the sequence stops, estimated against
+    the last run at their actual ratio.  Below BUDGET_RATIO: no extra run."""
+    from femehl.auto import BUDGET_RATIO, LADDERS
+
+    scene = femehl.presets.paper_sphere()
+    cells = LADDERS["fe"].cells
+    budget = int(cells(scene, 0.1, 1.5))  # levels 4, 2, then at most 2 / sqrt 2 = 1.41 wanted
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        res = solve_to_tolerance(scene, t_end=0.1, tol=1e-4, max_elements=budget, store_every=0)
+    auto = res.info["auto"]
+    levels = auto["levels"]
+    assert auto["reached"] is False and len(levels) == 3 and levels[:2] == [4.0, 2.0]
+    assert cells(scene, 0.1, levels[2]) <= budget < cells(scene, 0.1, 0.99 * levels[2])  # within 1 %
+    assert levels[1] / levels[2] >= BUDGET_RATIO and "the finest within it" in caplog.text
+    # its estimate is the pair with the level-2 run at their ratio (1.33), not a ratio of 2
+    ratio = levels[1] / levels[2]
+    assert ratio == pytest.approx(2.0 / 1.5, rel=0.01)
+    film = res.estimate["film_min"]["total"]
+    assert film[-1] > 0 and np.isfinite(film).all()
+    # a budget that buys less than BUDGET_RATIO over level 2: two runs only
+    tight = int(cells(scene, 0.1, 2.0 / (0.9 * BUDGET_RATIO)))
+    res = solve_to_tolerance(scene, t_end=0.1, tol=1e-4, max_elements=tight, store_every=0)
+    assert res.info["auto"]["levels"] == [4.0, 2.0]
+
+
 # ---- run folders and the command line ----------------------------------------------------
 def test_cli_default_is_automatic(tmp_path, capsys):
     """``femehl run`` with no discretization options: automatic to 1 %, estimate printed and in

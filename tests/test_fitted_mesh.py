@@ -215,6 +215,30 @@ def test_edge_band_narrows_with_beta():
     assert w[2] == F.W_MIN
 
 
+def test_thin_films_get_a_contact_zone_at_the_edge_scale(tmp_path):
+    """Above beta ~ 218 the contact zone is at most C_CONTACT_EDGE edge sizes (the trapped
+    dimple's rim crosses it during the approach); up to beta = 200 it is unchanged.  The
+    gmsh mesh honours it: element sizes (sqrt of 4 area / sqrt 3) inside the contact zone of
+    a beta = 20000 sphere at level 2."""
+    paper = [fitted_sizes(femehl.presets.paper_sphere(beta=b), 3.0) for b in (20.0, 200.0)]
+    assert [s.h_contact for s in paper] == [pytest.approx(0.095, rel=1e-12)] * 2
+    for beta in (2000.0, 20000.0):
+        s = fitted_sizes(femehl.presets.paper_sphere(beta=beta), 3.0)
+        assert s.h_contact == pytest.approx(F.C_CONTACT_EDGE * s.edge_coef * min(s.ax, s.ay), rel=1e-12)
+        assert s.h_contact < 0.5 * 0.095
+    sc = femehl.presets.paper_sphere(beta=20000.0)
+    s = fitted_sizes(sc, 3.0, level=2.0)
+    dm = fitted_disk(sc, 3.0, level=2.0, cache_dir=tmp_path)
+    p, t = dm.mesh.p, dm.mesh.t
+    c = p[:, t].mean(axis=1)
+    a = p[:, t[1]] - p[:, t[0]]
+    b = p[:, t[2]] - p[:, t[0]]
+    h = np.sqrt(4.0 / math.sqrt(3.0) * 0.5 * np.abs(a[0] * b[1] - a[1] * b[0]))
+    inner = np.hypot(*c) < 0.6 * s.ax
+    assert inner.sum() > 100
+    assert np.median(h[inner]) == pytest.approx(s.h_contact, rel=0.25)
+
+
 @pytest.mark.parametrize("level", [0.0, -1.0, math.nan, "fine"])
 def test_bad_level(level):
     with pytest.raises(MeshError, match="level"):

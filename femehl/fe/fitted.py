@@ -27,9 +27,10 @@ on the y axis, in ``[min(ax, ay), max(ax, ay)]``), and ``dn = (rho - 1) ell``
 approximates the signed distance to the contact edge (exact on the axes).
 With ``a_min = min(ax, ay)`` and sizes multiplied by ``level``:
 
-* contact zone ``rho <= 1.3``: ``h_contact = 0.095 a_min`` (the ``medium``
-  rung's 0.095 for the unit sphere; ``a_min`` because the triangles are
-  isotropic and must resolve the short axis);
+* contact zone ``rho <= 1.3``: ``h_contact = min(0.095, 2.4 * 0.2035 W(beta))
+  a_min`` (the ``medium`` rung's 0.095 for the unit sphere; ``a_min`` because
+  the triangles are isotropic and must resolve the short axis; at most 2.4 times
+  the edge size, see "Thin films" below);
 * edge band ``|dn| <= w``, ``w = W(beta) ell``: ``h_edge = 0.2035 w`` (about
   ten elements across the band ``2 w``; ``0.0407`` at ``beta = 200``, the
   ``medium`` rung's edge size), growing linearly to ``h_contact`` over
@@ -56,7 +57,20 @@ for the constriction itself; the measured zone, which includes the opening,
 shrinks more slowly.)  The floor 0.05 keeps the band resolvable on a mesh for
 ``beta >~ 10^4``.
 
-Accuracy (``benchmarks/fitted_mesh.md``): on the shipped ellipsoid (both
+Thin films: the contact zone
+----------------------------
+Up to 2026-12-03 the contact zone was ``0.095 a_min`` at every beta, 9.3 times the
+edge size at ``beta = 20000``.  There, during the approach, the minimum film is on
+the rim of the trapped dimple, which crosses the contact zone (r ~ 0.2 to the edge):
+on the ``sphere_b20000_approach`` scene of ``benchmarks/auto_scenes.py`` (BDF2,
+dt = 0.0025, to t = 1; ``benchmarks/fitted_thin.md``) the minimum film of levels 1
+and 0.7 (10,846 and 21,842 elements) differed by 17 % at t ~ 0.6, and from a mesh
+whose contact zone is capped at 2.33 edge sizes (25,618 elements) by 27 % and 11 %;
+with the cap, 13,142 elements (level 1.4) were within 1.3 % of those 25,618 (central
+film 0.18 %, against 3.7 % and 1.9 %).  The cap ``C_CONTACT_EDGE = 2.4`` keeps every
+mesh of ``beta <= 218`` as it was (their ratio is at most 2.33).
+
+Accuracy (``benchmarks/fitted_mesh.md``, before the cap for beta = 2000): on the shipped ellipsoid (both
 orientations) a fitted mesh with the element count of the ``medium`` rung
 (``level = 1.45``) is within 1 % of the extrapolated minimum film at
 ``t = 3``, where the ``medium`` rung is 11-13 % low (``xfine``, four times the
@@ -103,6 +117,9 @@ CACHE_DIR = pathlib.Path("~/.cache/femehl/meshes")
 C_CONTACT = 0.095
 #: h_edge / w: about ten elements across the band 2 w (medium rung: 0.0407 / 0.2).
 C_EDGE = 0.2035
+#: h_contact is at most this many times the edge size on the short axis (the medium
+#: rung's ratio 0.095 / 0.0407 = 2.33 at beta = 200: the cap acts from beta ~ 218 on)
+C_CONTACT_EDGE = 2.4
 #: Band half-width / ell = max(W_MIN, C_WIDTH * beta**WIDTH_EXPONENT).
 C_WIDTH = 1.17
 WIDTH_EXPONENT = -1.0 / 3.0
@@ -472,7 +489,7 @@ def fitted_sizes(scene, t_end: float, level: float = 1.0) -> FittedSizes:
     return FittedSizes(
         ax=ax,
         ay=ay,
-        h_contact=C_CONTACT * min(ax, ay) * level,
+        h_contact=min(C_CONTACT, C_CONTACT_EDGE * C_EDGE * width) * min(ax, ay) * level,
         edge_coef=C_EDGE * width * level,
         width=width,
         h_far=min(C_FAR * L * level, L),

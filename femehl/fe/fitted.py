@@ -63,11 +63,11 @@ Up to 2026-12-03 the contact zone was ``0.095 a_min`` at every beta, 9.3 times t
 edge size at ``beta = 20000``.  There, during the approach, the minimum film is on
 the rim of the trapped dimple, which crosses the contact zone (r ~ 0.2 to the edge):
 on the ``sphere_b20000_approach`` scene of ``benchmarks/auto_scenes.py`` (BDF2,
-dt = 0.0025, to t = 1; ``benchmarks/fitted_thin.md``) the minimum film of levels 1
-and 0.7 (10,846 and 21,842 elements) differed by 17 % at t ~ 0.6, and from a mesh
-whose contact zone is capped at 2.33 edge sizes (25,618 elements) by 27 % and 11 %;
-with the cap, 13,142 elements (level 1.4) were within 1.3 % of those 25,618 (central
-film 0.18 %, against 3.7 % and 1.9 %).  The cap ``C_CONTACT_EDGE = 2.4`` keeps every
+dt = 0.0025, to t = 1; ``benchmarks/fitted_thin.md``) the uncapped levels 1 and 0.7
+(10,846 and 21,842 elements) are 27 % and 11 % off the finest capped mesh (level 0.7,
+50,120 elements) in the minimum film (central film 3.8 % and 2.0 %), the capped
+levels 1.4 and 1 (12,778 and 24,736 elements) 2.0 % and 1.25 % (0.33 % and 0.11 %).
+The cap ``C_CONTACT_EDGE = 2.4`` keeps every
 mesh of ``beta <= 218`` as it was (their ratio is at most 2.33).
 
 Accuracy (``benchmarks/fitted_mesh.md``, before the cap for beta = 2000): on the shipped ellipsoid (both

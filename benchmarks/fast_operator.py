@@ -32,11 +32,12 @@ from _machine import machine
 HERE = Path(__file__).resolve().parent
 ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", MPLBACKEND="Agg")
 
-#: fitted-mesh levels of the ladder (about 3k .. 500k half-disk elements; 0.32: the largest
-#: mesh whose dense operator fits this machine, about 29k elements)
+#: fitted-mesh levels of the ladder (about 3k .. 500k half-disk elements; 0.25: 45,156
+#: elements, the largest ladder mesh whose dense run fits this machine)
 LEVELS = [1.0, 0.5, 0.32, 0.25, 0.177, 0.125, 0.0735]
-#: the dense path is run where it fits (elements x free nodes x 8 bytes x 4 copies < 60 % RAM)
-DENSE_LEVELS = [1.0, 0.5, 0.32]
+#: the dense path is run where it fits (femehl.fe.mesh.dense_bytes <= 80 % of the memory;
+#: the largest dense mesh here is about 47,000 half-disk elements)
+DENSE_LEVELS = [1.0, 0.5, 0.32, 0.25]
 
 
 def _scene():
@@ -45,7 +46,12 @@ def _scene():
     return paper_sphere()
 
 
-def case(level: float, operator: str, steps: int) -> dict:
+def case(level: float, operator: str, steps: int, save: str | None = None) -> dict:
+    """The first ``steps`` steps of the paper case on the fitted mesh of ``level``.
+
+    ``save``: also write the histories (t, load, central and minimum film) to this
+    ``.npz``, to compare the two operators over a whole run.
+    """
 
     import femehl
     from femehl.fe.fitted import fitted_disk
@@ -68,6 +74,10 @@ def case(level: float, operator: str, steps: int) -> dict:
         callback=lambda s: stamps.append((time.perf_counter(), s.info.get("krylov_iterations", 0))),
     )
     wall = time.perf_counter() - t1
+    if save:
+        import numpy as np
+
+        np.savez(save, t=res.t, load=res.load, film_center=res.film_center, film_min=res.film_min)
     return {
         "level": level,
         **_figures(res, [t1 + res.info["setup_s"]] + [t for t, _ in stamps], stamps, t_mesh),
@@ -216,8 +226,17 @@ def write(
     import numpy as np
 
     ok = [r for r in rows if "error" not in r]
-    fast = sorted([r for r in ok if r["operator"] == "fast"], key=lambda r: r["elements"])
-    dense = sorted([r for r in ok if r["operator"] == "dense"], key=lambda r: r["elements"])
+    # the ladder: the rows of the first steps (whole-run rows, more steps, are paired only)
+    first = min((r["steps"] for r in ok), default=0)
+    fast = sorted([r for r in ok if r["operator"] == "fast" and r["steps"] == first], key=lambda r: r["elements"])
+    dense = sorted([r for r in ok if r["operator"] == "dense" and r["steps"] == first], key=lambda r: r["elements"])
+    pairs = [
+        (d, f)
+        for d in ok
+        for f in ok
+        if (d["operator"], f["operator"]) == ("dense", "fast")
+        and (f["elements"], f["steps"]) == (d["elements"], d["steps"])
+    ]
     lines = [
         "# Fast (hierarchical) elastic operator against the dense one",
         "",
@@ -233,7 +252,7 @@ def write(
         "| peak RSS GiB | steps |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for r in sorted(ok, key=lambda r: (r["elements"], r["operator"])):
+    for r in sorted(ok, key=lambda r: (r["steps"], r["elements"], r["operator"])):
         lines.append(
             f"| {r['operator']} | {r['elements']} | {r['setup_s']:.1f} | {r['ms_per_step']:.0f} | "
             f"{r['krylov_per_step']:.1f} ({r['krylov_max']}) | {r['operator_bytes'] / r['elements']:.0f} | "
@@ -267,17 +286,16 @@ def write(
                 f"{big[0]['krylov_per_step']:.1f} -> {big[-1]['krylov_per_step']:.1f}."
             )
         lines.append("")
-    pairs = [(d, f) for d in dense for f in fast if f["elements"] == d["elements"]]
     if pairs:
         lines.append("Fast against dense on the same mesh:")
         lines.append("")
         lines.append(
-            "| elements | time per step dense / fast | peak RSS dense / fast | operator bytes dense / fast |"
+            "| elements | steps | time per step dense / fast | peak RSS dense / fast | operator bytes dense / fast |"
         )
-        lines.append("|---|---|---|---|")
+        lines.append("|---|---|---|---|---|")
         for d, f in pairs:
             lines.append(
-                f"| {d['elements']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
+                f"| {d['elements']} | {d['steps']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
                 f"{d['peak_rss'] / f['peak_rss']:.2f} | {d['operator_bytes'] / f['operator_bytes']:.2f} |"
             )
         lines.append("")
@@ -362,6 +380,7 @@ def main(argv=None) -> int:
     c.add_argument("--level", type=float, required=True)
     c.add_argument("--operator", default="fast")
     c.add_argument("--steps", type=int, default=30)
+    c.add_argument("--save", help="also write the histories to this .npz")
     sub.add_parser("report", help="rewrite the .md and .png from the .jsonl (and the textured .json)")
     x = sub.add_parser("textured")
     x.add_argument("--elements", type=int, default=200_000)
@@ -378,7 +397,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=HERE / "fast_operator")
     a = ap.parse_args(argv)
     if a.cmd == "case":
-        print(json.dumps(case(a.level, a.operator, a.steps)))
+        print(json.dumps(case(a.level, a.operator, a.steps, a.save)))
         return 0
     if a.cmd == "textured":
         print(json.dumps(textured(a.elements, a.t_end, a.out)))

@@ -22,6 +22,7 @@ from femehl.fe.mesh import (
     LADDER,
     MAX_GMSH_ELEMENTS,
     check_mesh_memory,
+    dense_bytes,
     estimate_elements,
     graded_disk,
     load_mesh,
@@ -105,17 +106,48 @@ def test_machine_memory_reads_sysconf_and_falls_back(monkeypatch):
 
 def test_operator_estimate_is_elements_times_free_nodes_times_8():
     assert operator_bytes(1000, 500) == 4_000_000
+    # + two float64 film products and a float32 (default) or float64 (lu) LU of 500 x 500
+    assert dense_bytes(1000, 500) == 4_000_000 + 20 * 250_000
+    assert dense_bytes(1000, 500, lu_itemsize=8) == 4_000_000 + 24 * 250_000
 
 
 def test_memory_check_names_estimate_and_machine_memory():
     with pytest.raises(
         MeshError,
         match=r"mesh big: 100000 elements and about 50000 free nodes need a dense "
-        r"elastic operator of 40 GB.*about 160 GB with the LU working "
-        r"copies, more than 60% of this machine's 16 GB",
+        r"elastic operator of 40 GB.*about 90 GB with the film products and the LU, "
+        r"more than 80% of this machine's 16 GB",
     ):
         check_mesh_memory(100_000, 50_000, "big", memory=16 * 10**9)
     check_mesh_memory(1000, 500, "small", memory=16 * 10**9)
+
+
+def test_dense_count_is_what_a_sliding_run_holds():
+    """The count of dense_bytes is the operator and film products the stepper formed
+    (both terms: the surface slides), plus the default solver's single-precision LU."""
+    import femehl
+
+    scene = femehl.presets.paper_sphere()
+    res = femehl.solve(scene, t_end=1.2, dt=0.1, mesh="coarse", operator="dense", estimate=False)
+    ne, n = res.info["elements"], res.info["unknowns"]
+    assert res.info["couette_assembled"] and res.info["squeeze_assembled"]
+    assert res.info["operator_bytes"] + 4 * n * n == dense_bytes(ne, n)
+
+
+def test_the_lu_solver_needs_a_double_precision_lu(monkeypatch):
+    """A machine where the default solver's run fits and linear_solver='lu''s does not."""
+    import femehl
+
+    dm = load_mesh("coarse")
+    scene = femehl.presets.paper_sphere()
+    probe = femehl.solve(scene, t_end=0.1, dt=0.1, mesh=dm, operator="dense", estimate=False)
+    ne, n = probe.info["elements"], probe.info["unknowns"]
+    between = (dense_bytes(ne, n) + dense_bytes(ne, n, lu_itemsize=8)) / 2 / M.MEMORY_FRACTION
+    monkeypatch.setattr(M, "machine_memory", lambda: int(between))
+    monkeypatch.setattr(M, "FAST_BYTES_PER_ELEMENT", 1)  # not the check under test here
+    femehl.solve(scene, t_end=0.1, dt=0.1, mesh=dm, operator="dense", estimate=False)
+    with pytest.raises(MeshError, match=r"with the film products and the LU"):
+        femehl.solve(scene, t_end=0.1, dt=0.1, mesh=dm, operator="dense", linear_solver="lu", estimate=False)
 
 
 def test_loading_a_mesh_too_big_for_the_machine_is_refused(monkeypatch, tmp_path):
@@ -131,7 +163,7 @@ def test_loading_a_mesh_too_big_for_the_machine_is_refused(monkeypatch, tmp_path
         load_mesh(medium.mesh)
     with pytest.raises(MeshError, match=r"mesh medium: 2982 elements"):
         load_mesh(medium)
-    dm = load_mesh("coarse")  # 1468 x ~770 nodes x 8 x 4 = 36 MB < 60 MB: fits
+    dm = load_mesh("coarse")  # 1468 x ~770 x 8 + 20 x 770^2 = 21 MB < 80 MB: fits
     assert dm.mesh.t.shape[1] == 1468
 
 

@@ -99,6 +99,10 @@ class LaggedStepper:
         if name == "lu" and solver_options:
             raise SceneError(f"linear_solver='lu' takes no options, got {sorted(solver_options)}.")
         self.solver = make_linear_solver(name, **solver_options)
+        if name == "lu" and disc.info.get("operator") == "dense":  # a double-precision LU
+            from ..fe.mesh import check_mesh_memory
+
+            check_mesh_memory(disc.info["elements"], disc.info["unknowns"], disc.info["mesh"], lu_itemsize=8)
         substrate = scene.substrate
         t1 = time.perf_counter()
         self.C = substrate.compliance_operator(disc)

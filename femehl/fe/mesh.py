@@ -107,6 +107,7 @@ __all__ = [
     "ladder_path",
     "load_mesh",
     "machine_memory",
+    "dense_bytes",
     "operator_bytes",
 ]
 
@@ -123,12 +124,19 @@ _EDGE_TRANSITION = 0.15
 
 _READABLE = "e.g. gmsh .msh, VTK .vtu or XDMF .xdmf"
 
-#: Refuse a mesh whose dense elastic operator (with the LU working copies) needs more
-#: than this fraction of the machine's physical memory.
-MEMORY_FRACTION = 0.6
-#: The dense elastic operator is elements x free nodes x 8 bytes; the solver holds about
-#: this many such arrays at once (the operator, the dense system and its LU copy, work).
-_OPERATOR_COPIES = 4
+#: Refuse a mesh whose run would need more than this fraction of the machine's physical
+#: memory (dense: :func:`dense_bytes`; fast: :data:`FAST_BYTES_PER_ELEMENT`).  Both are
+#: counts of what the run holds at its peak, checked against measured peaks, so the rest
+#: is the interpreter, the mesh and the sparse operators (0.7 GB at 45,156 elements).
+MEMORY_FRACTION = 0.8
+#: Besides the dense operator ``C`` (elements x free nodes), the dense path holds square
+#: ``free nodes x free nodes`` arrays: one film product ``F C`` per term that has one (the
+#: squeeze term always, the Couette term once the surface slides: 8 bytes an entry each),
+#: and the system's LU, 4 bytes an entry in the default solver (a single-precision
+#: preconditioner), 8 with ``linear_solver="lu"``.  Measured (benchmarks/fast_operator.md,
+#: peak RSS of the whole process): 15.0 GB at 45,156 elements and 22,636 free nodes in the
+#: first 30 steps of the paper case (squeeze only; counted 14.3 GB).
+_FILM_PRODUCTS = 2
 #: graded_disk refuses sizes that would make more elements than this (gmsh would run
 #: for hours and the solver could not hold the operator anyway).
 MAX_GMSH_ELEMENTS = 2_000_000
@@ -296,6 +304,16 @@ def operator_bytes(n_elements: int, n_free: int) -> int:
     return int(n_elements) * int(n_free) * 8
 
 
+def dense_bytes(n_elements: int, n_free: int, lu_itemsize: int = 4) -> int:
+    """Bytes a dense-path run holds at its peak: ``C``, the film products, the LU.
+
+    ``lu_itemsize``: 4 for the default solver (its LU is a single-precision
+    preconditioner), 8 for ``linear_solver="lu"``.  See :data:`_FILM_PRODUCTS`.
+    """
+    square = int(n_free) * int(n_free)
+    return operator_bytes(n_elements, n_free) + (8 * _FILM_PRODUCTS + int(lu_itemsize)) * square
+
+
 def _gb(n: float) -> str:
     return f"{n / 1e9:.3g} GB"
 
@@ -308,52 +326,50 @@ def _gb(n: float) -> str:
 #: are far from any limit)
 FAST_BYTES_PER_ELEMENT = 38_000
 
-#: the share of the memory a fast-operator run may take: its estimate is a measured peak
-#: (not a count of arrays times working copies, as for the dense one), so less margin
-FAST_MEMORY_FRACTION = 0.8
-
-
-def dense_fits(n_elements: int, n_free: int, memory: int | None = None) -> bool:
-    """True when the dense operator and its working copies fit (or the memory is unknown)."""
+def dense_fits(n_elements: int, n_free: int, memory: int | None = None, lu_itemsize: int = 4) -> bool:
+    """True when a dense-path run fits in ``MEMORY_FRACTION`` of the memory (or it is unknown)."""
     memory = machine_memory() if memory is None else memory
-    return memory is None or _OPERATOR_COPIES * operator_bytes(n_elements, n_free) <= MEMORY_FRACTION * memory
+    return memory is None or dense_bytes(n_elements, n_free, lu_itemsize) <= MEMORY_FRACTION * memory
 
 
 def check_mesh_memory(
-    n_elements: int, n_free: int, name: str, memory: int | None = None, operator: str = "dense"
+    n_elements: int,
+    n_free: int,
+    name: str,
+    memory: int | None = None,
+    operator: str = "dense",
+    lu_itemsize: int = 4,
 ) -> None:
-    """Raise MeshError if the elastic operator of this mesh would not fit in memory.
+    """Raise MeshError if a run on this mesh would not fit in memory.
 
-    ``operator="dense"``: the half-space substrate's dense ``elements x free nodes``
-    float64 operator, of which the solver holds about ``_OPERATOR_COPIES`` arrays
-    (system, LU), refused above :data:`MEMORY_FRACTION` of the physical memory.
+    ``operator="dense"``: :func:`dense_bytes` (the ``elements x free nodes`` float64
+    operator, the film products and the LU, ``lu_itemsize`` bytes an entry);
     ``operator="fast"``: :data:`FAST_BYTES_PER_ELEMENT` per element (a run with the
-    hierarchical operator of :mod:`femehl.hmatrix`), refused above
-    :data:`FAST_MEMORY_FRACTION`.  ``memory``: default :func:`machine_memory`; no check
-    if it is unknown.
+    hierarchical operator of :mod:`femehl.hmatrix`).  Refused above
+    :data:`MEMORY_FRACTION` of the physical memory.  ``memory``: default
+    :func:`machine_memory`; no check if it is unknown.
     """
     memory = machine_memory() if memory is None else memory
     if memory is None:
         return
     if operator == "fast":
         need = FAST_BYTES_PER_ELEMENT * int(n_elements)
-        if need > FAST_MEMORY_FRACTION * memory:
+        if need > MEMORY_FRACTION * memory:
             raise MeshError(
                 f"mesh {name}: {n_elements} elements need about {_gb(need)} even with the fast "
                 f"elastic operator ({FAST_BYTES_PER_ELEMENT // 1000} kB per element), more than "
-                f"{FAST_MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} of memory; use larger mesh "
+                f"{MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} of memory; use larger mesh "
                 "sizes (a larger level) or a machine with more memory"
             )
         return
-    one = operator_bytes(n_elements, n_free)
-    need = _OPERATOR_COPIES * one
-    if not dense_fits(n_elements, n_free, memory):
+    if not dense_fits(n_elements, n_free, memory, lu_itemsize):
         raise MeshError(
             f"mesh {name}: {n_elements} elements and about {n_free} free nodes need a dense elastic "
-            f"operator of {_gb(one)} (elements x free nodes x 8 bytes), about {_gb(need)} with the "
-            f"LU working copies, more than {MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} "
-            f"of memory; use operator='fast' (or 'auto', the default), a coarser mesh (a ladder "
-            f"name: {', '.join(LADDER)}) or larger mesh sizes"
+            f"operator of {_gb(operator_bytes(n_elements, n_free))} (elements x free nodes x 8 bytes), "
+            f"about {_gb(dense_bytes(n_elements, n_free, lu_itemsize))} with the film products and "
+            f"the LU, more than {MEMORY_FRACTION:.0%} of this machine's {_gb(memory)} of memory; use "
+            f"operator='fast' (or 'auto', the default), a coarser mesh (a ladder name: "
+            f"{', '.join(LADDER)}) or larger mesh sizes"
         )
 
 

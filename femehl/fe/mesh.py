@@ -127,16 +127,21 @@ _READABLE = "e.g. gmsh .msh, VTK .vtu or XDMF .xdmf"
 #: Refuse a mesh whose run would need more than this fraction of the machine's physical
 #: memory (dense: :func:`dense_bytes`; fast: :data:`FAST_BYTES_PER_ELEMENT`).  Both are
 #: counts of what the run holds at its peak, checked against measured peaks, so the rest
-#: is the interpreter, the mesh and the sparse operators (0.7 GB at 45,156 elements).
+#: is the interpreter, the mesh and the sparse operators (about 0.7 GB at 45,156 elements).
 MEMORY_FRACTION = 0.8
 #: Besides the dense operator ``C`` (elements x free nodes), the dense path holds square
 #: ``free nodes x free nodes`` arrays: one film product ``F C`` per term that has one (the
 #: squeeze term always, the Couette term once the surface slides: 8 bytes an entry each),
 #: and the system's LU, 4 bytes an entry in the default solver (a single-precision
-#: preconditioner), 8 with ``linear_solver="lu"``.  Measured (benchmarks/fast_operator.md,
-#: peak RSS of the whole process): 15.0 GB at 45,156 elements and 22,636 free nodes in the
-#: first 30 steps of the paper case (squeeze only; counted 14.3 GB).
+#: preconditioner), 8 with ``linear_solver="lu"``, counted twice: over a whole run the
+#: peak exceeds the arrays the stepper holds by about one more such array (the LU is
+#: refreshed 6 times; the old one is dropped first, the excess is measured, not traced).
+#: Measured (benchmarks/fast_operator.md, peak RSS of the whole process) at 45,156
+#: elements and 22,636 free nodes on the paper case: 15.0 GB in the first 30 steps
+#: (squeeze only; C + F C + LU 14.3 GB), 21.3 GB over the whole run (both film products;
+#: counted 20.5 GB).
 _FILM_PRODUCTS = 2
+_LU_ARRAYS = 2
 #: graded_disk refuses sizes that would make more elements than this (gmsh would run
 #: for hours and the solver could not hold the operator anyway).
 MAX_GMSH_ELEMENTS = 2_000_000
@@ -311,7 +316,7 @@ def dense_bytes(n_elements: int, n_free: int, lu_itemsize: int = 4) -> int:
     preconditioner), 8 for ``linear_solver="lu"``.  See :data:`_FILM_PRODUCTS`.
     """
     square = int(n_free) * int(n_free)
-    return operator_bytes(n_elements, n_free) + (8 * _FILM_PRODUCTS + int(lu_itemsize)) * square
+    return operator_bytes(n_elements, n_free) + (8 * _FILM_PRODUCTS + _LU_ARRAYS * int(lu_itemsize)) * square
 
 
 def _gb(n: float) -> str:
@@ -325,6 +330,7 @@ def _gb(n: float) -> str:
 #: textured ones, 31.6 kB at 514,644; smaller meshes, with the interpreter's own ~0.1 GB,
 #: are far from any limit)
 FAST_BYTES_PER_ELEMENT = 38_000
+
 
 def dense_fits(n_elements: int, n_free: int, memory: int | None = None, lu_itemsize: int = 4) -> bool:
     """True when a dense-path run fits in ``MEMORY_FRACTION`` of the memory (or it is unknown)."""

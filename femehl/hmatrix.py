@@ -380,10 +380,12 @@ class H2Operator:
             ay = ay.reshape(q.shape[0], q.shape[1], p)
             Qv[sl] = np.einsum("eqa,eqb->eab", ax, ay).reshape(-1, pp) * area[sl, None]
         rows = owner_s[:, None] * pp + np.arange(pp)[None, :]  # pp entries per column: CSC
+        # then stored as CSR: its product gathers instead of scattering, 7.3 -> 4.5 ms on
+        # 45,156 elements (C @ z 50.7 -> 47.4 ms), the same sums
         self._P2M = sp.csc_matrix(
             (Qv.ravel(), rows.ravel(), np.arange(0, self.n_sources * pp + 1, pp)),
             shape=(S.start.size * pp, self.n_sources),
-        )
+        ).tocsr()
         # transfer matrices (1-D, per child): parent's Lagrange basis at the child's nodes
         self._levels_S = self._transfers(S, nodes)
         self._levels_T = self._transfers(T, nodes)

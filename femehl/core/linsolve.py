@@ -508,14 +508,17 @@ class TwoLevel:
         self.near = near
         self.P = P
         self.AP = AP  # single precision: read once per application
-        Ac = np.asarray(P.T @ AP, dtype=float)
+        # P^T as CSR: row-wise, the same sums as P.T @ AP (CSC), which on a freshly formed
+        # AP took 0.46 s against 0.05 s on 45,156 elements (a third of each refresh)
+        self._Pt = P.T.tocsr()
+        Ac = np.asarray(self._Pt @ AP, dtype=float)
         try:
             self.lu = sla.lu_factor(Ac, check_finite=True)
         except (ValueError, sla.LinAlgError) as exc:
             raise _singular(t, f"the coarse system is singular ({exc})") from None
 
     def solve(self, r):
-        y = sla.lu_solve(self.lu, self.P.T @ r)
+        y = sla.lu_solve(self.lu, self._Pt @ r)
         APy = self.AP @ y.astype(np.float32)  # in single precision: no double copy of AP
         return self.P @ y + self.near.solve(r - APy)
 

@@ -248,7 +248,8 @@ def write(
         "Paper sphere (beta = 200), fitted half-disk meshes, BDF2 at dt = 0.01; ms per step is the "
         "mean over steps 5 to the last of the first `steps` steps (the contact forming), Krylov "
         "iterations per step likewise; peak RSS is the whole process (mesh, operators, solver). "
-        "Each case ran in its own process, one after another (the 45,156-element rows of b39ccda: "
+        "Each case ran in its own process, one after another (the 45,156-element rows of b39ccda and "
+        "the 44,792-element rows of 93f7c14: "
         "dense on one core, fast and other runs on the other, at the same time)." + _commits(rows),
         "",
         "| operator | elements | set-up s | ms / step | Krylov / step (max) | operator bytes / element "

@@ -221,6 +221,18 @@ def _commits(rows: list[dict]) -> str:
     return f" Commits: {', '.join(done)}." if done else ""
 
 
+def _one_session(rows: list[dict]) -> list[dict]:
+    """The ladder to fit and plot: the rows of the newest commit that ran at least three
+    sizes (wall times drift between sessions, so exponents come from one), else all rows;
+    sorted by elements."""
+    commits = [r.get("commit") for r in rows]
+    for c in reversed(commits):
+        if c is not None and commits.count(c) >= 3:
+            rows = [r for r in rows if r.get("commit") == c]
+            break
+    return sorted(rows, key=lambda r: r["elements"])
+
+
 def write(
     rows: list[dict], agreements: list[dict], path_md: Path, path_png: Path, tex: dict | None = None
 ) -> None:
@@ -230,7 +242,7 @@ def write(
     # the ladder: the rows of the first steps (whole-run rows, more steps, are paired only)
     first = min((r["steps"] for r in ok), default=0)
     ladder = [r for r in ok if r["steps"] == first]
-    fast = sorted([r for r in ladder if r["operator"] == "fast"], key=lambda r: r["elements"])
+    fast = _one_session([r for r in ladder if r["operator"] == "fast"])
     dense = sorted([r for r in ladder if r["operator"] == "dense"], key=lambda r: r["elements"])
     pairs = [
         (d, f)
@@ -272,11 +284,13 @@ def write(
     if len(fast) >= 3:
         n = [r["elements"] for r in fast]
         lines.append(
-            f"Fitted exponents over the fast ladder ({n[0]} to {n[-1]} elements): time per step "
+            f"Fitted exponents over the fast ladder ({n[0]} to {n[-1]} elements, commit "
+            f"{fast[-1].get('commit')}): time per step "
             f"N^{fit_exponent(n, [r['ms_per_step'] for r in fast]):.2f}, set-up "
             f"N^{fit_exponent(n, [r['setup_s'] for r in fast]):.2f}, operator bytes "
             f"N^{fit_exponent(n, [r['operator_bytes'] for r in fast]):.2f}, peak RSS "
-            f"N^{fit_exponent(n, [r['peak_rss'] for r in fast]):.2f} (N log N is about N^1.1 here)."
+            f"N^{fit_exponent(n, [r['peak_rss'] for r in fast]):.2f} (N log N fitted the same way: "
+            f"N^{fit_exponent(n, [k * math.log(k) for k in n]):.2f})."
         )
         big = [r for r in fast if r["elements"] >= 20_000]
         if len(big) >= 3:
@@ -285,7 +299,8 @@ def write(
             per_step = fit_exponent(nb, [r["ms_per_step"] for r in big])
             lines.append("")
             lines.append(
-                f"From {nb[0]} elements on: time per step N^{per_step:.2f}, "
+                f"From {nb[0]} elements on: time per step N^{per_step:.2f} (N log N: "
+                f"N^{fit_exponent(nb, [k * math.log(k) for k in nb]):.2f}), "
                 f"per Krylov iteration N^{fit_exponent(nb, per_it):.2f}, Krylov iterations per step "
                 f"{big[0]['krylov_per_step']:.1f} -> {big[-1]['krylov_per_step']:.1f}."
             )

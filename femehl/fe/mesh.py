@@ -133,15 +133,14 @@ MEMORY_FRACTION = 0.8
 #: ``free nodes x free nodes`` arrays: one film product ``F C`` per term that has one (the
 #: squeeze term always, the Couette term once the surface slides: 8 bytes an entry each),
 #: and the system's LU, 4 bytes an entry in the default solver (a single-precision
-#: preconditioner), 8 with ``linear_solver="lu"``, counted twice: over a whole run the
-#: peak exceeds the arrays the stepper holds by about one more such array (the LU is
-#: refreshed 6 times; the old one is dropped first, the excess is measured, not traced).
-#: Measured (benchmarks/fast_operator.md, peak RSS of the whole process) at 45,156
-#: elements and 22,636 free nodes on the paper case: 15.0 GB in the first 30 steps
-#: (squeeze only; C + F C + LU 14.3 GB), 21.3 GB over the whole run (both film products;
-#: counted 20.5 GB).
+#: preconditioner), 8 with ``linear_solver="lu"``; one LU at a time (a refresh frees the
+#: old one before it forms the new matrix, which LAPACK factors in place).  Measured
+#: (benchmarks/fast_operator.md, peak RSS of the whole process) on the paper case at
+#: 44,792 elements and 22,454 free nodes over the whole run (both film products): 18.9 GB,
+#: counted 18.1 GB; before the solver stopped holding the old LU during a refresh,
+#: 20.9 GB (and 21.3 GB at 45,156 elements).
 _FILM_PRODUCTS = 2
-_LU_ARRAYS = 2
+_LU_ARRAYS = 1
 #: graded_disk refuses sizes that would make more elements than this (gmsh would run
 #: for hours and the solver could not hold the operator anyway).
 MAX_GMSH_ELEMENTS = 2_000_000

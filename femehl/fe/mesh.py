@@ -127,7 +127,7 @@ _READABLE = "e.g. gmsh .msh, VTK .vtu or XDMF .xdmf"
 #: Refuse a mesh whose run would need more than this fraction of the machine's physical
 #: memory (dense: :func:`dense_bytes`; fast: :data:`FAST_BYTES_PER_ELEMENT`).  Both are
 #: counts of what the run holds at its peak, checked against measured peaks, so the rest
-#: is the interpreter, the mesh and the sparse operators (about 0.7 GB at 45,156 elements).
+#: is the interpreter, the mesh and the sparse operators (about 0.8 GB at 44,792 elements).
 MEMORY_FRACTION = 0.8
 #: Besides the dense operator ``C`` (elements x free nodes), the dense path holds square
 #: ``free nodes x free nodes`` arrays: one film product ``F C`` per term that has one (the
@@ -140,7 +140,6 @@ MEMORY_FRACTION = 0.8
 #: counted 18.1 GB; before the solver stopped holding the old LU during a refresh,
 #: 20.9 GB (and 21.3 GB at 45,156 elements).
 _FILM_PRODUCTS = 2
-_LU_ARRAYS = 1
 #: graded_disk refuses sizes that would make more elements than this (gmsh would run
 #: for hours and the solver could not hold the operator anyway).
 MAX_GMSH_ELEMENTS = 2_000_000
@@ -315,7 +314,7 @@ def dense_bytes(n_elements: int, n_free: int, lu_itemsize: int = 4) -> int:
     preconditioner), 8 for ``linear_solver="lu"``.  See :data:`_FILM_PRODUCTS`.
     """
     square = int(n_free) * int(n_free)
-    return operator_bytes(n_elements, n_free) + (8 * _FILM_PRODUCTS + _LU_ARRAYS * int(lu_itemsize)) * square
+    return operator_bytes(n_elements, n_free) + (8 * _FILM_PRODUCTS + int(lu_itemsize)) * square
 
 
 def _gb(n: float) -> str:

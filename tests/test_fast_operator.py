@@ -51,6 +51,24 @@ def test_fast_matches_dense(sphere, half):
     assert _rel(fast @ Z, dense @ Z) <= 1e-6  # several columns at once
 
 
+def test_single_precision_factors_keep_one_linear_map(sphere):
+    """At the default tolerance the far factors are stored in single precision but every
+    product and sum is in double: the operator stays linear to double rounding (no
+    single-precision floor under a Krylov residual), and the column product (factors
+    cast a chunk at a time) is the same map as the vector product."""
+    disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
+    fast = FastCompliance(disc)
+    assert fast.H.n_far > 0
+    assert {V.dtype for *_, V in fast.H._far_groups} == {np.dtype(np.float32)}
+    rng = np.random.default_rng(11)
+    a, b = rng.standard_normal((2, disc.n))
+    # double rounding of a sum over ~10^4 terms: far below single precision (6e-8)
+    assert _rel(fast @ (a + 2.0 * b), fast @ a + 2.0 * (fast @ b)) <= 1e-13
+    assert _rel(fast @ np.column_stack([a, b])[:, 1], fast @ b) <= 1e-13
+    tight = FastCompliance(disc, tol=1e-8)
+    assert {V.dtype for *_, V in tight.H._far_groups} == {np.dtype(np.float64)}
+
+
 def test_tighter_tolerance_is_more_accurate(sphere):
     disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
     dense = disc.boussinesq()

@@ -197,8 +197,8 @@ def test_graded_disk_memory_refused_before_gmsh(monkeypatch):
         raise AssertionError("gmsh must not run")
 
     monkeypatch.setattr(M, "_gmsh_disk", no_gmsh)
-    monkeypatch.setattr(M, "machine_memory", lambda: 10**9)
-    with pytest.raises(MeshError, match=r"graded_disk\(L=2, \.\.\.\) \(estimated\).*1 GB"):
+    monkeypatch.setattr(M, "machine_memory", lambda: 5 * 10**8)
+    with pytest.raises(MeshError, match=r"graded_disk\(L=2, \.\.\.\) \(estimated\).*0\.5 GB"):
         graded_disk(**LADDER["xfine"], half=False)
 
 

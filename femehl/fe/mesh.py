@@ -323,11 +323,11 @@ def _gb(n: float) -> str:
 
 #: bytes per element of a run with the fast (hierarchical) elastic operator: operator,
 #: preconditioner (with its coarse space) and solver, an upper bound of the measured peak
-#: memory per element from 89,000 elements on (benchmarks/fast_operator.md: 36.2 and
-#: 37.1 kB at 89,206 and 178,416 half-disk elements, 37.6 kB at 203,152 full-disk
-#: textured ones, 31.6 kB at 514,644; smaller meshes, with the interpreter's own ~0.1 GB,
-#: are far from any limit)
-FAST_BYTES_PER_ELEMENT = 38_000
+#: memory per element from 89,000 elements on (benchmarks/fast_operator.md, single-precision
+#: far factors, 3e0e5c7: 26.3-29.4 kB at 89,206, 27.4-27.5 kB at 178,416 and 26.0 kB at
+#: 514,644 half-disk elements, 26.9 kB at 203,152 full-disk textured ones; smaller meshes,
+#: with the interpreter's own ~0.1 GB, are far from any limit)
+FAST_BYTES_PER_ELEMENT = 32_000
 
 
 def dense_fits(n_elements: int, n_free: int, memory: int | None = None, lu_itemsize: int = 4) -> bool:

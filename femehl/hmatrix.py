@@ -287,10 +287,10 @@ class H2Operator:
         self.n_targets, self.n_sources = targets.shape[0], tri.shape[0]
         self.n_unknowns = int(n_unknowns)
         self.source_element = np.asarray(source_element)
-        self.fold = None if fold is None else sp.csr_matrix(fold)
-        self.n_cols = self.n_unknowns if fold is None else self.fold.shape[1]
+        fold = None if fold is None else sp.csr_matrix(fold)
+        self.n_cols = self.n_unknowns if fold is None else fold.shape[1]
         # gather the unknowns to the sources (sparse so a mirror image sums with its element)
-        self.G = sp.csr_matrix(
+        G = sp.csr_matrix(
             (np.ones(self.n_sources), (np.arange(self.n_sources), self.source_element)),
             shape=(self.n_sources, self.n_unknowns),
         )
@@ -303,15 +303,13 @@ class H2Operator:
         self.n_far, self.n_near = ft.size, nt.size
         t2 = time.perf_counter()
         nodes = _cheb(self.p)
-        self._near_perm, self.kept = self._near_field(targets, tri, T, S, nt, ns, keep)
+        self._near_perm, self.kept = self._near_field(targets, tri, T, S, nt, ns, keep, fold)
         t3 = time.perf_counter()
         self._build_bases(targets, tri, nodes)
         # the gather to the sources and the fold go into the leaf moments: one sparse
         # product from the columns of z (fewer entries: a leaf's triangles share nodes,
         # 7.26 -> 5.63 million on 44,792 elements, 5.0 -> 3.1 ms)
-        GF = self.G if self.fold is None else (self.G @ self.fold)
-        self._P2M = (self._P2M @ GF).tocsr()
-        self.G = self.fold = None
+        self._P2M = (self._P2M @ (G if fold is None else G @ fold)).tocsr()
         self._build_far(nodes, ft, fs, svd_tol)
         t4 = time.perf_counter()
         self.info = {
@@ -330,13 +328,14 @@ class H2Operator:
         }
 
     # -- set-up ---------------------------------------------------------------------------
-    def _near_field(self, targets, tri, T, S, nt, ns, keep=None):
+    def _near_field(self, targets, tri, T, S, nt, ns, keep=None, fold=None):
         """Exact entries of every near leaf pair: sparse, rows in the target tree's order.
 
         Built a group of target leaves at a time (a contiguous row range), so the peak
         memory is the matrix plus one group.  ``keep(i, j_source)`` -> bool mask selects
         the entries also returned as ``(rows, element columns, values)`` (the
-        preconditioner's), in natural row order.
+        preconditioner's), in natural row order.  ``fold`` (sparse, unknowns x columns)
+        is multiplied into each group.
         """
         order = np.argsort(T.start[nt], kind="stable")
         nt, ns = nt[order], ns[order]
@@ -364,7 +363,7 @@ class H2Operator:
             r0 = int(T.start[bt].min())
             r1 = int((T.start[bt] + T.size[bt]).max())
             M = sp.csr_matrix((v, (row - r0, self.source_element[J])), shape=(r1 - r0, self.n_unknowns))
-            chunks.append((r0, M if self.fold is None else (M @ self.fold).tocsr()))
+            chunks.append((r0, M if fold is None else (M @ fold).tocsr()))
             if keep is not None:
                 m = keep(I, J)
                 kept.append((I[m], self.source_element[J[m]], v[m]))

@@ -258,6 +258,12 @@ def _one_session(rows: list[dict]) -> list[dict]:
     return sorted(rows, key=lambda r: r["elements"])
 
 
+def _experiment(r: dict) -> str:
+    """``", refactor_after=5 (6 preconditioner LUs)"`` for a row of another refresh policy,
+    in the commit cell (a cell past the header's would not be shown)."""
+    return f", {r['experiment']} ({r['factorizations']} preconditioner LUs)" if r.get("experiment") else ""
+
+
 def write(
     rows: list[dict], agreements: list[dict], path_md: Path, path_png: Path, tex: dict | None = None
 ) -> None:
@@ -301,12 +307,7 @@ def write(
         lines.append(
             f"| {r['operator']} | {r['elements']} | {r['setup_s']:.1f} | {r['ms_per_step']:.0f} | "
             f"{r['krylov_per_step']:.1f} ({r['krylov_max']}) | {r['operator_bytes'] / r['elements']:.0f} | "
-            f"{r['peak_rss'] / 2**30:.2f} | {r['steps']} | {r.get('commit', '')} |"
-            + (
-                f" {r['experiment']}, {r['factorizations']} preconditioner LUs |"
-                if r.get("experiment")
-                else ""
-            )
+            f"{r['peak_rss'] / 2**30:.2f} | {r['steps']} | {r.get('commit', '')}{_experiment(r)} |"
         )
     for r in ok:
         if r.get("note"):

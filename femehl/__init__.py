@@ -23,6 +23,7 @@ from .errors import (
     SceneFileError,
     SingularSystemError,
     SolverError,
+    TimeBudgetError,
 )
 from .indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
 from .result import Result
@@ -93,4 +94,5 @@ __all__ = [
     "SolverError",
     "FilmRuptureError",
     "SingularSystemError",
+    "TimeBudgetError",
 ]

@@ -94,6 +94,22 @@ def is_automatic(scene, method: str | None, dt, options) -> bool:
     return dt is None and method in LADDERS and not (discretization_options(method) & set(options))
 
 
+#: options of the automatic mode only (:func:`femehl.auto.solve_to_tolerance`)
+AUTO_ONLY = ("max_elements", "max_wall", "level")
+
+
+def refuse_auto_only(options) -> None:
+    """SceneError when an expert run (``dt`` or a discretization option) got an option of
+    the automatic mode (:data:`AUTO_ONLY`)."""
+    given = sorted(k for k in AUTO_ONLY if k in options)
+    if given:
+        raise SceneError(
+            f"{', '.join(given)} apply to the automatic mode only, where femehl chooses the mesh "
+            "and the steps: leave out dt and the discretization options (mesh=, n_elements=, "
+            f"...), or leave out {', '.join(given)}."
+        )
+
+
 def solve(
     scene: Scene,
     method: str | None = None,
@@ -114,7 +130,8 @@ def solve(
       given): femehl chooses the mesh and the time steps so that the load, central and
       minimum film are within ``tol`` (default 1e-2) at every step
       (:func:`femehl.auto.solve_to_tolerance`); the result carries the error estimate,
-      ``result.uncertainty(name, t)``;
+      ``result.uncertainty(name, t)``; ``max_wall=`` (seconds) and ``max_elements=``
+      (cells) bound what it may spend;
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
       discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
       ``tol`` is given.  The result carries the space part of the error estimate from a
@@ -167,6 +184,7 @@ def solve(
             callback=callback,
             **options,
         )
+    refuse_auto_only(options)
     controls = {k: options.pop(k) for k in CONTROLS if k in options}
     if tol is None:
         dt = 0.01 if dt is None else dt

@@ -37,7 +37,16 @@ of about 3 GB is the limit) is not run.  Instead the finest level within the bud
 run, if it is at least :data:`BUDGET_RATIO` = 1.2 times finer than the last run
 (:func:`budget_level`), and the sequence stops there: when it does not reach ``tol``
 (or no such level exists) the last run is returned with ``info["auto"]["reached"] =
-False`` and a logging warning.  The companion of the
+False`` and a logging warning.  A time budget ``max_wall`` (seconds, default none) works the same way on the
+predicted wall time of each next run (:func:`predicted_wall`: the last run's cost per
+step times the cells ratio to the power fitted on the last two runs, times ``r`` times
+its steps): a level predicted to overrun what is left is not started, the finest level
+predicted to fit is run instead if it is at least BUDGET_RATIO finer, and the sequence
+stops there with ``info["auto"]["stopped"] = "time budget"``.  A run held in memory
+(every run of :func:`femehl.solve`, the pilots of ``femehl run``) that is still going at
+the deadline is abandoned and the last finished run returned; a candidate streaming into
+a run folder always finishes (its files replace the previous candidate's).  When no run
+finished in time, :class:`~femehl.errors.TimeBudgetError`.  The companion of the
 returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
 fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
 itself; the pilots less than that.
@@ -74,7 +83,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.adaptive import LOAD_FLOOR, UNIT_STEP
-from .errors import SceneError, SolverError
+from .errors import SceneError, SolverError, TimeBudgetError
 from .result import Result
 
 __all__ = [
@@ -88,6 +97,7 @@ __all__ = [
     "FAST_MAX_ELEMENTS",
     "cell_budget",
     "budget_level",
+    "predicted_wall",
     "time_tolerance",
 ]
 
@@ -153,6 +163,15 @@ class Ladder:
     #: ``companion(scene, options) -> (options, ratio) | None``: a coarser discretization
     #: (sizes ``ratio`` times) of an expert's options, for the space estimate of an expert run
     companion: Callable[..., tuple | None] | None = None
+    #: ``sizer(scene, t_end) -> cells(level)``: :attr:`cells` with what does not depend on
+    #: the level computed once (the budgets ask for many levels); default: :attr:`cells`
+    sizer: Callable[..., Callable[[float], float]] | None = None
+
+    def cells_of(self, scene, t_end: float) -> Callable[[float], float]:
+        """``cells(level)`` of ``scene`` over a run to ``t_end``."""
+        if self.sizer is not None:
+            return self.sizer(scene, t_end)
+        return lambda level: self.cells(scene, t_end, level)
 
 
 #: method name -> its :class:`Ladder`
@@ -174,10 +193,15 @@ def _fe_options(scene, t_end, level):
 
 
 def _fe_cells(scene, t_end, level):
+    return _fe_sizer(scene, t_end)(level)
+
+
+def _fe_sizer(scene, t_end):
     from .fe.fitted import fitted_sizes
 
     half = bool(getattr(scene.indenter, "symmetric_y", False))
-    return fitted_sizes(scene, t_end, level).estimate_elements(half)
+    base = fitted_sizes(scene, t_end, 1.0)  # the contact extent: the costly part (~0.4 s)
+    return lambda level: base.at_level(level).estimate_elements(half)
 
 
 #: line contact: 400 elements (the LineDisc default) at level 1
@@ -212,7 +236,7 @@ def _line_companion(scene, options):
     return ({**options, "n_elements": n // 2}, n / (n // 2)) if n >= 40 else None
 
 
-register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion))
+register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion, _fe_sizer))
 register_ladder(
     "line",
     Ladder(
@@ -355,12 +379,15 @@ def _where(est: dict) -> str:
 
 
 # ---- the driver --------------------------------------------------------------------------
-def _run(scene, method, ladder, t_end, level, store_every, options, runner=None, previous=None) -> Result:
+def _run(
+    scene, method, ladder, t_end, level, store_every, options, runner=None, previous=None, deadline=None
+) -> Result:
     """One adaptive run at ``level`` (its discretization from ``ladder``).
 
     ``runner(level=, tol_t=, options=, previous=)`` makes the runs that may be accepted
     (a run folder writes them as they go); the others, and all of them without a
-    runner, run in memory.
+    runner, run in memory.  A run in memory still going at ``deadline``
+    (``time.perf_counter()``) raises :class:`_OutOfTime`.
     """
     t0 = time.perf_counter()
     tol_t = time_tolerance(level)
@@ -370,9 +397,11 @@ def _run(scene, method, ladder, t_end, level, store_every, options, runner=None,
     else:
         from .api import solve
 
+        if deadline is not None:
+            disc["callback"] = _deadline_guard(deadline, disc.get("callback"))
         # the expert path with this level's discretization; the estimate is the pair's
         res = solve(scene, method, t_end=t_end, tol=tol_t, store_every=store_every, estimate=False, **disc)
-    n = int(res.info.get("elements", ladder.cells(scene, t_end, level)))
+    n = int(res.info["elements"]) if "elements" in res.info else int(ladder.cells(scene, t_end, level))
     res.info.update(level=level, elements=n, tol_t=tol_t, wall=time.perf_counter() - t0)
     logger.info(
         "auto: level %.3g (%d cells, time tolerance %.2g): %d steps, %.1f s",
@@ -392,16 +421,19 @@ def _next_level(level: float, err: float, tol: float) -> float:
     return level / min(hi, max(lo, ratio))
 
 
-def budget_level(ladder: Ladder, scene, t_end: float, previous: float, wanted: float, max_elements: int):
+def budget_level(cells, previous: float, wanted: float, max_elements: int, fits=None):
     """The finest level whose cells fit ``max_elements``, between ``wanted`` (the level the
     estimate asks for, over the budget) and ``previous`` (the last run's level), if it is
     at least :data:`BUDGET_RATIO` finer than ``previous``; else None.
 
-    By bisection in ``log(level)`` on :attr:`Ladder.cells` (nothing is built): the budget
+    By bisection in ``log(level)`` on ``cells(level)`` (:meth:`Ladder.cells_of`, nothing
+    is built): the budget
     still buys one more run, whose pair estimate (ratio >= BUDGET_RATIO to the last run)
-    is the one returned.
+    is the one returned.  ``fits(level) -> bool``, when given, must hold as well (the
+    time budget: :func:`predicted_wall`); it must be true on coarser levels if on a finer one.
     """
-    fits = lambda lv: ladder.cells(scene, t_end, lv) <= max_elements  # noqa: E731
+    within = fits if fits is not None else (lambda lv: True)
+    fits = lambda lv: cells(lv) <= max_elements and within(lv)  # noqa: E731
     lo, hi = math.log(previous / BUDGET_RATIO), math.log(wanted)
     if hi >= lo or not fits(math.exp(lo)):
         return None
@@ -409,6 +441,76 @@ def budget_level(ladder: Ladder, scene, t_end: float, previous: float, wanted: f
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if fits(math.exp(mid)) else (lo, mid)
     return math.exp(lo)
+
+
+#: exponent of the cost per step in the cells when the last two runs do not give it (one
+#: run: between the dense path's 2 and the rest's 1.1), and the range the fitted one is
+#: kept in: a fast or sparse step costs about cells^1.1, a dense one cells^2
+#: (``benchmarks/fast_operator.md``), while small runs, whose cost is mostly overhead, fit
+#: below 1 and the switch to the fast operator (set-up, compilation) costs more than
+#: either.  Replayed on the 128 recorded level changes of the auto and stress_auto
+#: benchmarks (``benchmarks/time_budget.md``), predicted / actual wall time: median 2.05,
+#: 0.45 to 18.7 (the pilots after the first run, which compiles); over the 59 runs
+#: longer than 20 s median 1.49, 0.45 to 4.3, under 1 in 12 (most near the switch to the
+#: fast operator).  With the range (1, 2), on the auto runs alone: median 1.35 over 20 s,
+#: but under 1 in 11 of 32 (5 of 32 with this range).
+COST_EXPONENT = 1.5
+COST_EXPONENT_RANGE = (1.3, 2.0)
+
+
+def predicted_wall(runs, cells: float, level: float) -> float:
+    """The wall time (s) of a run at ``level`` with ``cells`` cells, from the finished ``runs``.
+
+    Steps: the last run's times ``r = last level / level`` (adaptive BDF2 at ``tol_t``
+    proportional to ``level**2`` takes steps proportional to ``1 / level``; measured
+    ratios 1.6 to 1.85 per halving on the paper case).  Cost per step (set-up included):
+    the last run's times ``(cells / its cells)**e``, ``e`` fitted on the last two runs'
+    costs per step and kept in :data:`COST_EXPONENT_RANGE`, :data:`COST_EXPONENT` with
+    one run.  ``runs`` carry ``info["elements"]``, ``info["wall"]``, ``info["level"]``
+    and ``nsteps``.
+    """
+    last = runs[-1]
+    n1, w1, s1 = float(last.info["elements"]), float(last.info["wall"]), max(1, last.nsteps)
+    e = COST_EXPONENT
+    if len(runs) >= 2:
+        prev = runs[-2]
+        n0, w0, s0 = float(prev.info["elements"]), float(prev.info["wall"]), max(1, prev.nsteps)
+        if n1 > 1.05 * n0 and w0 > 0.0 and w1 > 0.0:
+            e = math.log((w1 / s1) / (w0 / s0)) / math.log(n1 / n0)
+            e = min(COST_EXPONENT_RANGE[1], max(COST_EXPONENT_RANGE[0], e))
+    ratio = float(last.info["level"]) / level
+    return w1 * (max(cells, 1.0) / n1) ** e * ratio
+
+
+def check_max_wall(max_wall) -> float | None:
+    """The automatic mode's time budget: None or a positive number of seconds."""
+    if max_wall is None:
+        return None
+    if isinstance(max_wall, bool) or not isinstance(max_wall, int | float) or not (0 < max_wall < math.inf):
+        raise SceneError(
+            f"max_wall must be a positive number of seconds (or None: no limit), got {max_wall!r}."
+        )
+    return float(max_wall)
+
+
+class _OutOfTime(Exception):
+    """A run held in memory was still going at the deadline of ``max_wall``."""
+
+    def __init__(self, t: float):
+        super().__init__(t)
+        self.t = t
+
+
+def _deadline_guard(deadline: float, callback):
+    """A state callback that calls ``callback`` and stops the run past ``deadline``."""
+
+    def guard(state):
+        if callback is not None:
+            callback(state)
+        if time.perf_counter() > deadline:
+            raise _OutOfTime(float(state.t))
+
+    return guard
 
 
 def cell_budget(scene, max_elements: int | None = None) -> int:
@@ -439,6 +541,7 @@ def solve_to_tolerance(
     method: str | None = None,
     store_every: int = 1,
     max_elements: int | None = None,
+    max_wall: float | None = None,
     level: float = LEVEL0,
     runner=None,
     **options,
@@ -447,10 +550,13 @@ def solve_to_tolerance(
 
     Returns the finest run (a :class:`~femehl.result.Result`) with ``result.estimate``
     (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
-    ``reached``, ``levels``, ``elements``, ``steps``, ``rejected_steps``, ``tol_t`` and
-    ``wall`` of every run, and the largest estimated ``total``, ``space`` and ``time``
-    errors.  ``level`` is the first (coarsest) level; ``max_elements`` the cell budget
-    (default: :func:`cell_budget` of the scene's substrate); ``options`` go to
+    ``reached``, ``stopped`` (None, ``"cell budget"`` or ``"time budget"``: what ended
+    a sequence that did not reach ``tol``), ``levels``, ``elements``, ``steps``,
+    ``rejected_steps``, ``tol_t`` and ``wall`` of every run, and the largest estimated
+    ``total``, ``space`` and ``time`` errors.  ``level`` is the first (coarsest) level;
+    ``max_elements`` the cell budget (default: :func:`cell_budget` of the scene's
+    substrate); ``max_wall`` a time budget in seconds for the whole sequence (default:
+    none; see the module docstring); ``options`` go to
     :func:`femehl.solve` (not the discretization's,
     nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run.
     """
@@ -468,34 +574,71 @@ def solve_to_tolerance(
         raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
     ladder = LADDERS[method]
     max_elements = cell_budget(scene, max_elements)
+    max_wall = check_max_wall(max_wall)
+    deadline = None if max_wall is None else time.perf_counter() + max_wall
+    cells = ladder.cells_of(scene, t_end)
     for key in ("dt_max", "dt", *ladder.keys):
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
+
+    def in_time(lv: float) -> bool:
+        """A run at ``lv`` is predicted to finish before the deadline (always without one)."""
+        if deadline is None:
+            return True
+        left = deadline - time.perf_counter()
+        return left > 0.0 and (not runs or predicted_wall(runs, cells(lv), lv) <= left)
+
     runs, est, reached, err = [], None, False, math.nan
-    fine, failed, last = None, None, False
+    fine, failed, last, stopped = None, None, False, None
     while True:
-        ne = ladder.cells(scene, t_end, level)
-        if (runs or failed) and ne > max_elements:
+        ne = cells(level)
+        over_cells = ne > max_elements
+        if (runs or failed) and (over_cells or not in_time(level)):
+            why = "cell budget" if over_cells else "time budget"
             fit = None
             if runs and not last:
-                fit = budget_level(ladder, scene, t_end, runs[-1].info["level"], level, max_elements)
+                fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
             if fit is None:
-                logger.info("auto: level %.3g would have ~%.0f cells > %d: stop", level, ne, max_elements)
+                logger.info("auto: level %.3g (~%.0f cells) is over the %s: stop", level, ne, why)
+                stopped = why
                 if failed is not None and not runs:
+                    if why == "time budget":
+                        raise TimeBudgetError(
+                            f"no run finished within max_wall = {max_wall:g} s: the film closed on the "
+                            f"coarser meshes ({failed}). Give a larger max_wall.",
+                            t=failed.t,
+                        ) from failed
                     raise failed  # no level within the budget got through
                 break
             logger.info(
-                "auto: level %.3g would have ~%.0f cells > %d: last run at level %.3g, the finest within it",
+                "auto: level %.3g (~%.0f cells) is over the %s: last run at level %.3g, the finest within it",
                 level,
                 ne,
-                max_elements,
+                why,
                 fit,
             )
-            level, last = fit, True
+            level, last, stopped = fit, True, why
         candidate = len(runs) >= MIN_RUNS - 1
         previous = runs[-1] if candidate else None
         try:
-            res = _run(scene, method, ladder, t_end, level, store_every, options, runner, previous)
+            res = _run(scene, method, ladder, t_end, level, store_every, options, runner, previous, deadline)
+        except _OutOfTime as exc:
+            stopped = "time budget"
+            if not runs:
+                raise TimeBudgetError(
+                    f"no run finished within max_wall = {max_wall:g} s: the first, at level {level:.3g} "
+                    f"(~{ne:.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. Give a larger "
+                    "max_wall, or a coarser first level (level=).",
+                    t=exc.t,
+                ) from None
+            logger.warning(
+                "auto: max_wall = %g s reached at t = %.4g of the run at level %.3g: it is abandoned, "
+                "the answer is the last finished run",
+                max_wall,
+                exc.t,
+                level,
+            )
+            break
         except SolverError as exc:
             if getattr(exc, "where", None) is None:
                 raise  # not a film that closes or a step floor: nothing a finer mesh changes
@@ -517,7 +660,7 @@ def solve_to_tolerance(
         if last:
             break
         level = _next_level(level, err, tol) if len(runs) >= 2 else level / 2.0
-    return _finish(fine, est, runs, tol, reached)
+    return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall)
 
 
 #: two runs whose films close within this fraction of t_end of each other, and within
@@ -558,12 +701,14 @@ def _closing_confirmed(earlier, exc, level, t_end):
     return exc
 
 
-def _finish(res: Result, est, runs, tol, reached) -> Result:
+def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -> Result:
     """Attach the estimate and the summary of the runs; warn when tol was not reached."""
     res.estimate = est
     info = {
         "tol": tol,
         "reached": reached,
+        "stopped": stopped,
+        "max_wall": max_wall,
         "levels": [r.info["level"] for r in runs],
         "elements": [r.info["elements"] for r in runs],
         "steps": [r.nsteps for r in runs],
@@ -576,10 +721,9 @@ def _finish(res: Result, est, runs, tol, reached) -> Result:
     res.info["auto"] = info
     if not reached:
         worst = "unknown (one level only)" if est is None else f"{info['total']:.3g}"
+        cells = max(info["elements"])
+        within = f"max_wall = {max_wall:g} s" if stopped == "time budget" else f"{cells} cells"
         logger.warning(
-            "solve_to_tolerance: tolerance %g not reached within %d cells: estimated error %s",
-            tol,
-            max(info["elements"]),
-            worst,
+            "solve_to_tolerance: tolerance %g not reached within %s: estimated error %s", tol, within, worst
         )
     return res

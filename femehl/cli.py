@@ -66,6 +66,12 @@ def _parser():
         "with --mesh/--dt: adaptive time steps to this local error per unit time",
     )
     r.add_argument(
+        "--max-wall",
+        type=float,
+        help="automatic mode: a time budget in seconds (a finer run predicted to overrun it is not "
+        "started; the answer says 'tol NOT reached' with its estimate)",
+    )
+    r.add_argument(
         "--scheme",
         choices=["euler", "bdf2"],
         help="FE time scheme: euler (the paper's, default) or bdf2 (second order)",
@@ -195,7 +201,7 @@ def _run(args, argv=()):
         )
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
-    for key in ("scheme", "mesh", "operator", "n_elements", "dt", "tol", "t_end", "store_every"):
+    for key in ("scheme", "mesh", "operator", "n_elements", "dt", "tol", "max_wall", "t_end", "store_every"):
         v = getattr(args, key)
         if v is not None and not (key == "scheme" and method == "fd"):  # fd: euler, its own scheme
             run[key] = v
@@ -315,7 +321,7 @@ def _print_choice(res) -> None:
         f"{n} cells / {k} steps / {w:.1f} s"
         for n, k, w in zip(a["elements"], a["steps"], a["wall"], strict=True)
     )
-    status = "reached" if a["reached"] else "NOT reached (budget)"
+    status = "reached" if a["reached"] else f"NOT reached ({a.get('stopped') or 'budget'})"
     print(
         f"femehl: automatic to tol = {a['tol']:g} ({status}): runs {runs}; the answer is the last "
         f"(estimated error up to {100 * a.get('total', float('nan')):.2g} %)"

@@ -57,6 +57,13 @@ class RelaxationDivergedError(SolverError):
         self.iterations = iterations
 
 
+class TimeBudgetError(SolverError):
+    """No run of the automatic mode finished within its time budget (``max_wall``).
+
+    ``t`` is the time the abandoned run had reached.
+    """
+
+
 class OutputError(FemehlError, ValueError):
     """An output folder cannot be used as asked (holds another run, is a file, is not writable)."""
 

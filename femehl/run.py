@@ -152,6 +152,9 @@ def run_to_folder(
         unless given.  ``store_every`` and ``checkpoint_every`` count accepted steps.
     **options
         Discretization options of the method (``mesh``, ``dr``, ``dtheta``, ...): expert mode.
+        Automatic mode: ``max_wall`` (seconds) and ``max_elements`` (cells), the budgets of
+        :func:`femehl.auto.solve_to_tolerance` (a candidate written here always finishes;
+        only the pilots in memory are abandoned at ``max_wall``).
 
     Raises
     ------
@@ -160,9 +163,13 @@ def run_to_folder(
     SolverError, KeyboardInterrupt
         The run stopped: ``exc.result`` is the partial Result, the files stay readable.
     """
-    from .api import DEFAULT_TOL, is_automatic
+    from .api import DEFAULT_TOL, is_automatic, refuse_auto_only
 
     tol = check_tol(tol)
+    if "max_wall" in options:  # checked before the folder is touched
+        from .auto import check_max_wall
+
+        options["max_wall"] = check_max_wall(options["max_wall"])
     resume, overwrite = check_resume_overwrite(resume, overwrite)
     say = _reporter(log)
     common = dict(
@@ -178,6 +185,7 @@ def run_to_folder(
     if resume:
         saved_auto = checkpoint.read_params(check_folder(folder, resume=True)).get("auto")
     if saved_auto is None and not is_automatic(scene, method, dt, options):
+        refuse_auto_only(options)
         res = _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
         if not resume:  # the space estimate from the coarser companion (a resumed run: its part only)
             _expert_estimate(scene, pathlib.Path(folder), res, dt, tol, options, t_end, say)
@@ -236,7 +244,9 @@ def _automatic(
 
     if resume:
         companion = auto.CompanionSeries(saved["companion"])
-        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **options}
+        # the saved candidate finishes: the budgets of the sequence no longer apply
+        kept = {k: v for k, v in options.items() if k not in ("max_wall", "max_elements")}
+        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **kept}
         res = stream(options, saved, resume=True)
         res.info.update(level=saved["level"], tol_t=saved["tol_t"])
         ratio = saved["companion"]["level"] / saved["level"]

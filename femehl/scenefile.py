@@ -28,13 +28,14 @@ A commented example is ``examples/paper_sphere.toml``; the format::
                           force (a number or [motion.force] table) and hc_dot0
     [domain]              L = 2.0
     [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions,
-                          tol, operator ("auto" | "dense" | "fast"), operator_tol
+                          tol, operator ("auto" | "dense" | "fast"), operator_tol,
+                          max_wall (automatic mode: a time budget in seconds)
 
 Line contact (a rigid cylinder, gap x^2/2, on a Winkler foundation; see
 :mod:`femehl.line`): ``[indenter] kind = "cylinder"`` needs ``[substrate]
 kind = "winkler"`` and gives a :class:`femehl.line.LineScene` (k, beta, motion,
 L); its [run] takes method = "line", n_elements, grading ("uniform" or a size
-ratio >= 1), scheme, t_end, dt, store_every.  See
+ratio >= 1), scheme, t_end, dt, store_every, tol, max_wall.  See
 ``examples/cylinder_winkler.toml``.  A user gap profile (``LineScene(profile=...)``, a
 Python function) exists only in Python.
 
@@ -111,9 +112,10 @@ RUN_KEYS = {
     "tol",
     "operator",
     "operator_tol",
+    "max_wall",
 }
 #: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
-LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading", "tol"}
+LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading", "tol", "max_wall"}
 
 
 def _build(registry, table, where, path):

@@ -301,3 +301,93 @@ def test_cell_budget_follows_the_substrate():
     for bad in (0, -3, 2.5, True, "many"):
         with pytest.raises(femehl.SceneError, match="max_elements must be a positive integer"):
             cell_budget(paper, bad)
+
+
+# ---- the time budget ---------------------------------------------------------------------
+class _Run:
+    """What :func:`femehl.auto.predicted_wall` reads of a finished run."""
+
+    def __init__(self, level, elements, steps, wall):
+        self.info = {"level": level, "elements": elements, "wall": wall}
+        self.nsteps = steps
+
+
+def test_predicted_wall_follows_the_fitted_cost():
+    """Two runs whose cost per step grows like cells^1.6 (inside the range): the next one,
+    at half the level, is predicted with that exponent and twice the steps; outside the
+    range the exponent is clipped; with one run it is COST_EXPONENT."""
+    from femehl.auto import COST_EXPONENT, COST_EXPONENT_RANGE, predicted_wall
+
+    a = _Run(2.0, 1000, 100, 100 * 1e-3)
+    b = _Run(1.0, 4000, 200, 200 * 1e-3 * 4.0**1.6)
+    assert predicted_wall([a, b], 16000, 0.5) == pytest.approx(b.info["wall"] * 4.0**1.6 * 2.0)
+    assert predicted_wall([b], 16000, 0.5) == pytest.approx(b.info["wall"] * 4.0**COST_EXPONENT * 2.0)
+    cheap = _Run(1.0, 4000, 200, 200 * 1e-3)  # the same cost per step: clipped up
+    lo, hi = COST_EXPONENT_RANGE
+    assert predicted_wall([a, cheap], 16000, 0.5) == pytest.approx(cheap.info["wall"] * 4.0**lo * 2.0)
+    dear = _Run(1.0, 4000, 200, 200 * 1e-3 * 4.0**3)  # cells^3: clipped down
+    assert predicted_wall([a, dear], 16000, 0.5) == pytest.approx(dear.info["wall"] * 4.0**hi * 2.0)
+
+
+def test_max_wall_is_checked():
+    from femehl.auto import check_max_wall
+
+    assert check_max_wall(None) is None and check_max_wall(60) == 60.0
+    scene = femehl.presets.paper_sphere()
+    for bad in (0, -1.0, True, "60", float("nan"), float("inf")):
+        with pytest.raises(femehl.SceneError, match="max_wall must be a positive number of seconds"):
+            femehl.solve(scene, t_end=0.1, max_wall=bad)
+    with pytest.raises(femehl.SceneError, match="automatic mode only"):
+        femehl.solve(scene, t_end=0.02, dt=0.01, mesh="coarse", max_wall=60)
+
+
+def test_no_run_in_time_is_a_time_budget_error():
+    """A budget shorter than the first run: TimeBudgetError naming the fix (a run's initial
+    state alone takes longer than 1 ms to set up)."""
+    with pytest.raises(femehl.TimeBudgetError, match="Give a larger max_wall"):
+        femehl.solve(femehl.presets.paper_sphere(), t_end=0.1, tol=1e-3, max_wall=1e-3)
+
+
+def test_time_budget_stops_with_the_last_finished_run(monkeypatch, caplog):
+    """A third run predicted to overrun what is left (and no level >= BUDGET_RATIO finer
+    predicted to fit): the sequence stops after two runs, and the answer is the second
+    with its pair estimate, ``stopped = "time budget"``, and a warning."""
+    import femehl.auto as auto
+
+    real = auto.predicted_wall
+    monkeypatch.setattr(auto, "predicted_wall", lambda runs, cells, level: 1e9 if len(runs) >= 2 else 0.0)
+    scene = femehl.presets.paper_sphere()
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        res = femehl.solve(scene, t_end=0.1, tol=1e-4, max_wall=3600, store_every=0)
+    a = res.info["auto"]
+    assert a["levels"] == [4.0, 2.0] and a["reached"] is False and a["stopped"] == "time budget"
+    assert a["max_wall"] == 3600.0 and "over the time budget: stop" in caplog.text
+    assert "not reached within max_wall = 3600 s" in caplog.text
+    assert np.isfinite(res.uncertainty("film_min", 0.1)["total"])
+    # the cell budget is named as such
+    monkeypatch.setattr(auto, "predicted_wall", real)
+    res = solve_to_tolerance(scene, t_end=0.1, level=3.0, max_elements=100, store_every=0)
+    assert res.info["auto"]["stopped"] == "cell budget"
+
+
+def test_max_wall_reaches_the_cli_and_scene_files(tmp_path, capsys):
+    """``--max-wall`` and ``[run] max_wall`` reach the automatic run (a budget no run meets:
+    the run stops with femehl's error naming the fix); a bad value is refused before the
+    output folder is made."""
+    from femehl.cli import EXIT_BAD_INPUT, EXIT_STOPPED, main
+
+    argv = ["run", "--t-end", "0.1", "--quiet", "--max-wall", "0.001", "--out", str(tmp_path / "cli")]
+    assert main(argv) == EXIT_STOPPED
+    assert "no run finished within max_wall = 0.001 s" in capsys.readouterr().err
+    scene = tmp_path / "s.toml"
+    scene.write_text(
+        '[indenter]\nkind = "sphere"\n[substrate]\nkind = "halfspace"\n[run]\nt_end = 0.1\nmax_wall = 0.001\n'
+    )
+    assert main(["run", str(scene), "--quiet", "--out", str(tmp_path / "toml")]) == EXIT_STOPPED
+    assert "max_wall = 0.001 s" in capsys.readouterr().err
+    scene.write_text(
+        '[indenter]\nkind = "sphere"\n[substrate]\nkind = "halfspace"\n[run]\nmax_wall = "soon"\n'
+    )
+    assert main(["run", str(scene), "--quiet", "--out", str(tmp_path / "bad")]) == EXIT_BAD_INPUT
+    assert "max_wall must be a positive number of seconds" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

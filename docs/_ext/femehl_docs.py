@@ -157,6 +157,13 @@ EXTRA_DOCS = {
         "Automatic mode: the largest mesh (cells) the refinement may reach; past it the run "
         'stops with ``result.info["auto"]["reached"]`` False (the estimate tells how far it got).',
     ),
+    "max_wall": (
+        "float",
+        "Automatic mode: a time budget in seconds for the whole sequence; a finer run predicted "
+        "to overrun it is not started (and a run in memory still going at the deadline is "
+        'abandoned), the answer is the last finished run with ``result.info["auto"]["stopped"]`` '
+        '"time budget" when it did not reach ``tol``.',
+    ),
     "level": (
         "float",
         "Automatic mode: the first (coarsest) level of the scene-fitted mesh; each further "
@@ -226,7 +233,7 @@ class SolveOptions(Directive):
             "Automatic mode (no ``dt``, no discretization option)",
             "femehl.auto.solve_to_tolerance",
             auto.solve_to_tolerance,
-            names={"max_elements", "level"},
+            names={"max_elements", "max_wall", "level"},
         )
 
         lines = []
@@ -249,6 +256,7 @@ RUN_KEY_DOCS = {
     "tol": ("solve ``tol``", "automatic accuracy, or adaptive steps with a mesh"),
     "operator": ("FE ``operator``", '"auto", "dense" or "fast"'),
     "operator_tol": ("FE ``operator_tol``", "the fast operator's relative error"),
+    "max_wall": ("automatic ``max_wall``", "a time budget in seconds (automatic mode)"),
     "n_elements": ("line ``n_elements``", "number of P1 elements"),
     "grading": ("line ``grading``", '"uniform" or a size ratio >= 1'),
 }

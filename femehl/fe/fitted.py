@@ -86,7 +86,7 @@ import hashlib
 import json
 import math
 import pathlib
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -440,16 +440,46 @@ class FittedSizes:
             zone = h_c + (self.h_far - h_c) * frac
         return min(band, zone)
 
+    def sizes(self, x, y) -> np.ndarray:
+        """:meth:`size` at arrays of points: the same formula, vectorized."""
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        ax, ay, L = self.ax, self.ay, self.L
+        u, v = x / ax, y / ay
+        rho = np.sqrt(u * u + v * v)
+        g = np.hypot(u / ax, v / ay)
+        ell = np.where(g > 0.0, rho / np.where(g > 0.0, g, 1.0), min(ax, ay))
+        h_c = self.h_contact
+        h_e = self.edge_coef * ell
+        dn = np.abs(rho - 1.0) * ell
+        band = h_e + np.abs(h_c - h_e) * np.maximum(dn - self.width * ell, 0.0) / (TRANSITION * ell)
+        r = np.hypot(x, y)
+        rc = RHO_CONTACT * r / np.where(rho > 0.0, rho, 1.0)
+        far = rc < L
+        frac = np.where(far, np.minimum((r - rc) / np.where(far, L - rc, 1.0), 1.0), 0.0)
+        zone = np.where(rho <= RHO_CONTACT, h_c, h_c + (self.h_far - h_c) * frac)
+        return np.minimum(band, zone)
+
+    def at_level(self, level: float) -> FittedSizes:
+        """These sizes at another ``level`` (the contact extent kept, nothing recomputed):
+        what :func:`fitted_sizes` gives at ``level``, to rounding."""
+        level = _check_level(level)
+        k = level / self.level
+        return replace(
+            self,
+            h_contact=self.h_contact * k,
+            edge_coef=self.edge_coef * k,
+            h_far=min(C_FAR * self.L * level, self.L),
+            level=level,
+        )
+
     def estimate_elements(self, half: bool) -> float:
         """About how many triangles gmsh makes: ``int 4 / (sqrt(3) h^2) dA`` (polar midpoint rule)."""
         nr, nt = 500, 240
         r = (np.arange(nr) + 0.5) * self.L / nr
         span = math.pi if half else 2.0 * math.pi
         th = (np.arange(nt) + 0.5) * span / nt
-        tot = 0.0
-        for t in th:
-            c, s = math.cos(t), math.sin(t)
-            tot += sum(ri / self.size(ri * c, ri * s) ** 2 for ri in r)
+        R, T = np.meshgrid(r, th)
+        tot = float(np.sum(R / self.sizes(R * np.cos(T), R * np.sin(T)) ** 2))
         return tot * (self.L / nr) * (span / nt) * 4.0 / math.sqrt(3.0)
 
     def key(self, half: bool) -> dict:

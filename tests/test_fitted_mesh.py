@@ -207,6 +207,25 @@ def test_level_scales_sizes_and_elements(tmp_path):
     assert 1.7 < n2 / n1 < 2.4
 
 
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_vectorized_sizes_and_other_levels_are_the_same_field(name):
+    """``sizes`` (arrays) is ``size`` (scalar, what gmsh calls) point by point, including
+    the origin, the contact edge and the rim; ``at_level`` is ``fitted_sizes`` at that
+    level, and so are their cell estimates."""
+    sc = SCENES[name]
+    base = fitted_sizes(sc, 3.0, 1.0)
+    rng = np.random.default_rng(1)
+    x, y = rng.uniform(-2.0, 2.0, (2, 500))
+    x[:3], y[:3] = (0.0, base.ax, 2.0), (0.0, 0.0, 0.0)
+    scalar = np.array([base.size(a, b) for a, b in zip(x, y, strict=True)])
+    np.testing.assert_allclose(base.sizes(x, y), scalar, rtol=1e-14)
+    for level in (4.0, 0.5):
+        direct = fitted_sizes(sc, 3.0, level)
+        moved = base.at_level(level)
+        np.testing.assert_allclose(moved.sizes(x, y), direct.sizes(x, y), rtol=1e-14)
+        assert moved.estimate_elements(False) == pytest.approx(direct.estimate_elements(False), rel=1e-12)
+
+
 def test_edge_band_narrows_with_beta():
     """W(beta) = max(0.05, 1.17 beta^(-1/3)): 0.2 at beta = 200."""
     w = [fitted_sizes(femehl.presets.paper_sphere(beta=b), 3.0).width for b in (200.0, 2000.0, 1e6)]

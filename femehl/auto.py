@@ -41,8 +41,10 @@ False`` and a logging warning.  A time budget ``max_wall`` (seconds, default non
 predicted wall time of each next run (:func:`predicted_wall`: the last run's cost per
 step times the cells ratio to the power fitted on the last two runs, times ``r`` times
 its steps): a level predicted to overrun what is left is not started, the finest level
-predicted to fit is run instead if it is at least BUDGET_RATIO finer, and the sequence
-stops there with ``info["auto"]["stopped"] = "time budget"``.  A run held in memory
+predicted to fit is run instead if it is at least BUDGET_RATIO finer; then the next level
+is predicted again from the runs so far (a run cheaper than predicted leaves time for
+another), and the sequence stops, with ``info["auto"]["stopped"] = "time budget"``, when
+no level BUDGET_RATIO finer than the last run is predicted to fit.  A run held in memory
 (every run of :func:`femehl.solve`, the pilots of ``femehl run``) that is still going at
 the deadline is abandoned and the last finished run returned; a candidate streaming into
 a run folder always finishes (its files replace the previous candidate's).  When no run
@@ -617,7 +619,9 @@ def solve_to_tolerance(
                 why,
                 fit,
             )
-            level, last, stopped = fit, True, why
+            # the cell budget's fit is the finest level there is; the time budget's is
+            # asked again after the run (a run cheaper than predicted leaves time for more)
+            level, last, stopped = fit, why == "cell budget", why
         candidate = len(runs) >= MIN_RUNS - 1
         previous = runs[-1] if candidate else None
         try:

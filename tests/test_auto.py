@@ -391,3 +391,20 @@ def test_max_wall_reaches_the_cli_and_scene_files(tmp_path, capsys):
     assert main(["run", str(scene), "--quiet", "--out", str(tmp_path / "bad")]) == EXIT_BAD_INPUT
     assert "max_wall must be a positive number of seconds" in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()
+
+
+def test_time_budget_is_asked_again_after_a_fitted_run(monkeypatch):
+    """Unlike the cell budget's, the time budget's fitted level is not the last: a run
+    cheaper than predicted leaves time, and the next level is predicted again.  Here the
+    prediction lets levels >= 1.5 fit after two runs, >= 1.1 after three, none after four:
+    runs at 4, 2, the finest level >= 1.5 and then the finest >= 1.1."""
+    import femehl.auto as auto
+
+    floor = {1: 0.0, 2: 1.5, 3: 1.1}
+    monkeypatch.setattr(
+        auto, "predicted_wall", lambda runs, cells, level: 0.0 if level >= floor.get(len(runs), 9.0) else 1e9
+    )
+    res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.1, tol=1e-5, max_wall=3600, store_every=0)
+    a = res.info["auto"]
+    assert a["levels"][:2] == [4.0, 2.0] and len(a["levels"]) == 4 and a["stopped"] == "time budget"
+    assert a["levels"][2] == pytest.approx(1.5, rel=0.01) and a["levels"][3] == pytest.approx(1.1, rel=0.01)

@@ -596,10 +596,18 @@ def solve_to_tolerance(
         ne = cells(level)
         over_cells = ne > max_elements
         if (runs or failed) and (over_cells or not in_time(level)):
-            why = "cell budget" if over_cells else "time budget"
-            fit = None
+            fit = cell_fit = None
             if runs and not last:
                 fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
+                cell_fit = (
+                    fit
+                    if deadline is None
+                    else budget_level(cells, runs[-1].info["level"], level, max_elements)
+                )
+            # the budget that binds: time, when the cells alone are not exceeded or allow a
+            # finer level than the time does (beyond the bisection's 1 %)
+            time_binds = not over_cells or (cell_fit is not None and (fit is None or cell_fit < fit / 1.02))
+            why = "time budget" if time_binds else "cell budget"
             if fit is None:
                 logger.info("auto: level %.3g (~%.0f cells) is over the %s: stop", level, ne, why)
                 stopped = why
@@ -613,7 +621,7 @@ def solve_to_tolerance(
                     raise failed  # no level within the budget got through
                 break
             logger.info(
-                "auto: level %.3g (~%.0f cells) is over the %s: last run at level %.3g, the finest within it",
+                "auto: level %.3g (~%.0f cells) is over the %s: a run at level %.3g, the finest within it",
                 level,
                 ne,
                 why,

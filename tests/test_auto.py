@@ -408,3 +408,22 @@ def test_time_budget_is_asked_again_after_a_fitted_run(monkeypatch):
     a = res.info["auto"]
     assert a["levels"][:2] == [4.0, 2.0] and len(a["levels"]) == 4 and a["stopped"] == "time budget"
     assert a["levels"][2] == pytest.approx(1.5, rel=0.01) and a["levels"][3] == pytest.approx(1.1, rel=0.01)
+
+
+def test_the_budget_that_binds_is_named(monkeypatch):
+    """The level the estimate asks for is over the cell budget, but the time allows only a
+    coarser level than the cells would: that run is the time budget's (named so, and the
+    prediction is asked again after it), not the cell budget's last run."""
+    import femehl.auto as auto
+
+    scene = femehl.presets.paper_sphere()
+    cells = auto.LADDERS["fe"].cells_of(scene, 0.1)
+    floor = {1: 0.0, 2: 1.5}
+    monkeypatch.setattr(
+        auto, "predicted_wall", lambda runs, n, level: 0.0 if level >= floor.get(len(runs), 9.0) else 1e9
+    )
+    budget = int(cells(1.2))  # the cells alone would allow level 1.2 after level 2
+    res = femehl.solve(scene, t_end=0.1, tol=1e-5, max_wall=3600, max_elements=budget, store_every=0)
+    a = res.info["auto"]
+    assert len(a["levels"]) == 3 and a["levels"][2] == pytest.approx(1.5, rel=0.01)
+    assert a["stopped"] == "time budget"

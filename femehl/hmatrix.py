@@ -602,6 +602,9 @@ def order_for(tol: float) -> int:
     return int(min(14, 5 + math.ceil(need - 1e-9)))
 
 
+#: the default ``operator_tol`` of the fast path (``femehl.solve(..., operator_tol=...)``)
+DEFAULT_OPERATOR_TOL = 1e-6
+
 #: operator tolerances from which the far factors are stored in single precision (their
 #: relative rounding, about 6e-8, is then at most 6 % of the tolerance)
 SINGLE_FACTORS_TOL = 1e-6
@@ -627,7 +630,7 @@ class FastCompliance:
 
     is_fast = True
 
-    def __init__(self, disc, tol: float = 1e-6, factor: float = 1.0, coarse: bool = True):
+    def __init__(self, disc, tol: float = DEFAULT_OPERATOR_TOL, factor: float = 1.0, coarse: bool = True):
         tol = check_operator_tol(tol)
         t0 = time.perf_counter()
         ne = disc.nelements

@@ -25,6 +25,7 @@ from skfem import Basis, ElementTriP0, ElementTriP1
 from ..errors import SceneError
 from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
+from ..hmatrix import DEFAULT_OPERATOR_TOL
 from ..kernels import (
     edge_terms,
     mesh_edges,
@@ -83,7 +84,7 @@ class FEDisc(P1P0):
         preconditioned with a sparse LU of the near field).  "auto": fast from
         :data:`FAST_CROSSOVER` elements on, or when the dense operator does not fit in
         memory.
-    operator_tol : float, default: 1e-6
+    operator_tol : float, default: :data:`femehl.hmatrix.DEFAULT_OPERATOR_TOL`
         Relative error of the fast operator (sets its interpolation order).
     """
 
@@ -98,7 +99,7 @@ class FEDisc(P1P0):
         mesh="medium",
         half: bool | None = None,
         operator: str = "auto",
-        operator_tol: float = 1e-6,
+        operator_tol: float = DEFAULT_OPERATOR_TOL,
     ):
         t0 = time.perf_counter()
         if not isinstance(operator, str) or operator not in OPERATORS:

@@ -642,18 +642,16 @@ def main(argv=None) -> int:
                 fh.write(json.dumps(r) + "\n")
                 fh.flush()
                 print(json.dumps(r), flush=True)
-        for level in a.error_levels:
-            r = _run(["error", "--level", str(level)], a.timeout)
-            r["kind"] = "operator_error"
-            errors.append(r)
-            fh.write(json.dumps(r) + "\n")
-            print(json.dumps(r), flush=True)
-        for level in a.agree_levels:
-            r = _run(["agree", "--level", str(level)], a.timeout)
-            r["kind"] = "agree"
-            agreements.append(r)
-            fh.write(json.dumps(r) + "\n")
-            print(json.dumps(r), flush=True)
+        for kind, levels, into in (
+            ("error", a.error_levels, errors),
+            ("agree", a.agree_levels, agreements),
+        ):
+            for level in levels:
+                r = _run([kind, "--level", str(level)], a.timeout)
+                r["kind"] = "operator_error" if kind == "error" else kind
+                into.append(r)
+                fh.write(json.dumps(r) + "\n")
+                print(json.dumps(r), flush=True)
     return _report(a.out)
 
 

@@ -442,7 +442,8 @@ def write(
         lines.append("|---|---|---|---|---|")
         for d, f in pairs:
             lines.append(
-                f"| {d['elements']} | {d['steps']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
+                f"| {d['elements']}{' (' + f['experiment'] + ')' if f.get('experiment') else ''} | "
+                f"{d['steps']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
                 f"{d['peak_rss'] / f['peak_rss']:.2f} | {d['operator_bytes'] / f['operator_bytes']:.2f} |"
             )
         lines.append("")

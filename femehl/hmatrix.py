@@ -587,12 +587,14 @@ class H2Operator:
 #: ``_ERR_P5 / _ERR_FACTOR**(p - 5)`` bounds the error of a random vector (the
 #: Frobenius-like relative error, the largest of the vectors tried) measured against
 #: exact rows on the fitted paper-sphere half disks from 2,988 to 514,644 elements
-#: (``python benchmarks/fast_operator.py error``, ``benchmarks/fast_operator.md``): at
-#: p = 9 from 2.8e-7 (2,988) to 1.3e-6 (11,450), 1.0e-6 (47,296), 7.9e-7 (178,416); at
-#: p = 10 2.4e-7 to 2.8e-7 from 11,450 on; at p = 12 7.9e-9 (2,988).  A smooth vector
-#: (a Hertz-like pressure) is 30 times more accurate.  (Until 2026-12-04 the model was
-#: fitted on 2,988 and 11,472 elements only, 1.3e-4 at p = 5, and gave p = 9 at the
-#: default 1e-6: 1.3e-6 measured.)
+#: (``python benchmarks/fast_operator.py error``, ``benchmarks/fast_operator.md``), the
+#: couplings truncated at 0.1 tol: at p = 9 from 2.8e-7 (2,988) to 1.3e-6 (11,450),
+#: 1.0e-6 (47,296), 7.9e-7 (178,416), 1.1e-6 (514,644); at p = 10 2.4e-7 to 3.3e-7 from
+#: 11,450 on; at p = 12 7.9e-9 (2,988).  A smooth vector (a Hertz-like pressure) is 30
+#: times more accurate.  With the couplings truncated at tol (:data:`SVD_RATIO`) the
+#: default (p = 10) measures 1.9e-7 to 4.8e-7 over the same meshes.  (Until 2026-12-04
+#: the law was fitted on 2,988 and 11,472 elements only, 1.3e-4 at p = 5, and gave p = 9
+#: at the default 1e-6.)
 _ERR_P5, _ERR_FACTOR = 3.4e-4, 4.0
 
 

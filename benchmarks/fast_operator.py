@@ -140,11 +140,39 @@ SOURCES = (
 )
 
 
-def agree(level: float, t_end: float, sources: bool = False) -> dict:
+def _variant(spec: str):
+    """``"p:eta:svd_ratio"`` -> (name, a context that builds the fast operator so).
+
+    An experiment: the module constants femehl reads when it builds the operator
+    (``order_for``, ``ETA``, ``SVD_RATIO``) are swapped for one run and restored."""
+    import contextlib
+
+    import femehl.hmatrix as H
+
+    p, eta, ratio = spec.split(":")
+    p, eta, ratio = int(p), float(eta), float(ratio)
+
+    @contextlib.contextmanager
+    def built():
+        saved = H.order_for, H.ETA, H.SVD_RATIO
+        H.order_for, H.ETA, H.SVD_RATIO = (lambda tol: p), eta, ratio
+        try:
+            yield
+        finally:
+            H.order_for, H.ETA, H.SVD_RATIO = saved
+
+    return f"fast_p{p}_eta{eta:g}_svd{ratio:g}", built
+
+
+def agree(level: float, t_end: float, sources: bool = False, variants: tuple = ()) -> dict:
     """Whole paper case: the fast and the dense path (defaults), and the fast path at
     ``operator_tol = TIGHT_OPERATOR_TOL``, against the dense operator solved to
     rtol = 1e-10 (about the exact solution of the same discretization); with
-    ``sources``, also the runs of :data:`SOURCES`."""
+    ``sources``, also the runs of :data:`SOURCES`; each of ``variants``
+    (``"p:eta:svd_ratio"``, :func:`_variant`) a fast run at the default rtol with the
+    operator built so."""
+    import contextlib
+
     import numpy as np
 
     import femehl
@@ -154,17 +182,20 @@ def agree(level: float, t_end: float, sources: bool = False) -> dict:
     dm = fitted_disk(scene, 5.0, level)
     out = {"level": level, "t_end": t_end, "tight_operator_tol": TIGHT_OPERATOR_TOL}
     runs = {}
-    for name, opts in (
-        ("reference", {"operator": "dense", "rtol": 1e-10}),
-        ("dense", {"operator": "dense"}),
-        ("fast", {"operator": "fast"}),
-        ("fast_tight", {"operator": "fast", "operator_tol": TIGHT_OPERATOR_TOL}),
-        *(SOURCES if sources else ()),
+    plain = contextlib.nullcontext
+    for name, opts, built in (
+        ("reference", {"operator": "dense", "rtol": 1e-10}, plain),
+        ("dense", {"operator": "dense"}, plain),
+        ("fast", {"operator": "fast"}, plain),
+        ("fast_tight", {"operator": "fast", "operator_tol": TIGHT_OPERATOR_TOL}, plain),
+        *((n, o, plain) for n, o in (SOURCES if sources else ())),
+        *((n, {"operator": "fast"}, b) for n, b in map(_variant, variants)),
     ):
         t0 = time.perf_counter()
-        runs[name] = femehl.solve(
-            scene, t_end=t_end, dt=0.01, mesh=dm, scheme="bdf2", estimate=False, store_every=0, **opts
-        )
+        with built():
+            runs[name] = femehl.solve(
+                scene, t_end=t_end, dt=0.01, mesh=dm, scheme="bdf2", estimate=False, store_every=0, **opts
+            )
         out[f"{name}_s"] = time.perf_counter() - t0
     out["elements"] = runs["fast"].info["elements"]
     for name, res in runs.items():  # the Chebyshev order each fast run's tolerance gave
@@ -181,18 +212,34 @@ def agree(level: float, t_end: float, sources: bool = False) -> dict:
     return out
 
 
-#: rows of the exact operator sampled by ``error`` (uniformly over the elements)
-ERROR_ROWS = 384
+#: the couplings' truncation (femehl.hmatrix.SVD_RATIO) of the error rows recorded before
+#: rows carried it: 0.1 until 566eb3b, then 1
+_SVD_BEFORE = {"36c856f": 0.1, "6759f61": 0.1, "566eb3b": 1.0}
+
+#: rows of the exact operator sampled by ``error`` (uniformly over the elements) and the
+#: random vectors it applies at once (64 estimate the Frobenius ratio to about 10 %; rows
+#: before 2026-12-04's last session used one)
+ERROR_ROWS, ERROR_VECTORS = 384, 64
 
 
-def operator_error(level: float, tols: list[float], rows: int = ERROR_ROWS) -> list[dict]:
+def operator_error(
+    level: float,
+    tols: list[float],
+    rows: int = ERROR_ROWS,
+    vectors: int = ERROR_VECTORS,
+    p: int | None = None,
+    svd_ratio: float | None = None,
+) -> list[dict]:
     """Relative error of the fast operator at each ``operator_tol`` on the fitted mesh of
     ``level``, against exact rows at ``rows`` elements drawn uniformly
     (:func:`femehl.hmatrix.sampled_error`): so it is measured where the dense operator
     does not fit.
 
-    For a random vector (standard normal nodal values) and a smooth one (``1 - r**2``
-    inside the unit circle, the shape of a Hertz pressure).  One record per tolerance,
+    For ``vectors`` random vectors at once (standard normal nodal values; the Frobenius
+    ratio over them: one vector's error scatters by a factor of 5) and a smooth one
+    (``1 - r**2`` inside the unit circle, the shape of a Hertz pressure).  ``p`` and
+    ``svd_ratio`` override the order and truncation the tolerance gives (experiment rows,
+    tagged and not the default's).  One record per tolerance,
     with the Chebyshev order, the far factors' precision, the build seconds and bytes of
     the operator (the preconditioner's coarse space is not built).
     """
@@ -205,17 +252,25 @@ def operator_error(level: float, tols: list[float], rows: int = ERROR_ROWS) -> l
     scene = _scene()
     disc = FEDisc(scene, mesh=fitted_disk(scene, 5.0, level), operator="fast")
     vectors = {
-        "random": np.random.default_rng(7).standard_normal(disc.n),
+        "random": np.random.default_rng(7).standard_normal((disc.n, vectors) if vectors > 1 else disc.n),
         "smooth": np.maximum(0.0, 1.0 - np.hypot(*disc.nodes[disc.free].T) ** 2),
     }
     out = []
     for tol in tols:
         t0 = time.perf_counter()
-        C = FastCompliance(disc, tol=tol, coarse=False)
+        C = FastCompliance(disc, tol=tol, coarse=False, p=p, svd_ratio=svd_ratio)
         build = time.perf_counter() - t0
+        extra = {}
+        if p is not None or svd_ratio is not None:
+            extra["experiment"] = ", ".join(
+                f"{k}={v:g}" for k, v in (("p", p), ("svd_ratio", svd_ratio)) if v is not None
+            )
         out.append(
             {
+                **extra,
                 "kind": "operator_error",
+                "vectors": vectors,
+                "svd_ratio": C.svd_ratio,
                 "level": level,
                 "elements": disc.nelements,
                 "rows": min(rows, disc.nelements),
@@ -443,25 +498,28 @@ def write(
             "z (standard normal nodal values) and a smooth one (1 - r^2 in the unit circle, the "
             "shape of a Hertz pressure); p the Chebyshev order the tolerance gave, the far "
             "factors' storage precision, the operator's build s and bytes per element (without the "
-            "preconditioner). One random vector per row: its error scatters by a factor of 5 "
-            "between vectors (the rows of largest error dominate it); over 64 vectors on 11,450 "
-            "elements (`femehl.hmatrix.sampled_error`, one session) order 9 measures 5.3e-7 and "
-            "the order-10 default 2.3e-7, so the single-vector 1.3e-6 of order 9 there was the "
-            "sample's." + _commits(errors)
+            "preconditioner); 'vectors' how many random vectors (the Frobenius ratio over them): "
+            "the error of one scatters by a factor of 5 between vectors (the rows of largest "
+            "error dominate it), so the single-vector rows (before 2026-12-04's last session) "
+            "are samples, not estimates; svd the couplings' truncation relative to "
+            "operator_tol." + _commits(errors)
         )
         lines.append("")
         lines.append(
-            "| elements | operator_tol | p | far factors | random z | smooth z | build s "
-            "| bytes / element | commit |"
+            "| elements | operator_tol | p | svd | far factors | random z (vectors) | smooth z "
+            "| build s | bytes / element | commit |"
         )
-        lines.append("|---|---|---|---|---|---|---|---|---|")
+        lines.append("|---|---|---|---|---|---|---|---|---|---|")
         order = lambda e: (e.get("commit") or "", e.get("elements", 0), -e.get("tol", 0))  # noqa: E731
         for e in sorted(errors, key=order):
             if "args" in e:
-                lines.append(f"| failed | {' '.join(e['args'])} | {e['error'][-200:]!r} |  |  |  |  |  |  |")
+                failed = f"| failed | {' '.join(e['args'])} | {e['error'][-200:]!r} |"
+                lines.append(failed + "  |" * 7)
                 continue
+            svd = e.get("svd_ratio", _SVD_BEFORE.get(e.get("commit"), 0.1))
             lines.append(
-                f"| {e['elements']} | {e['tol']:g} | {e['p']} | {e['factors']} | {e['random']:.1e} | "
+                f"| {e['elements']} | {e['tol']:g} | {e['p']} | {svd:g} | {e['factors']} | "
+                f"{e['random']:.1e} ({e.get('vectors', 1)}) | "
                 f"{e['smooth']:.1e} | {e['build_s']:.0f} | {e['bytes'] / e['elements']:.0f} | "
                 f"{e.get('commit', '')}{', ' + e['experiment'] if e.get('experiment') else ''} |"
             )
@@ -525,6 +583,32 @@ def write(
                 lines.append(
                     f"| {a['elements']} | {cell(a, 'fast_operator_part')} | {cell(a, 'fast_krylov_part')} "
                     f"| {cell(a, 'fast')} | {cell(a, 'fast_both')} | {a.get('commit', '')} |"
+                )
+            lines.append("")
+        variants = [
+            (a, k[: -len("_film_min")])
+            for a in agreements
+            for k in a
+            if k.startswith("fast_p") and k.endswith("_film_min")
+        ]
+        if variants:
+            lines.append(
+                "Operator variants (`agree --variant P:ETA:SVD`, experiments): the fast path at "
+                "its default rtol with the operator built at Chebyshev order P, admissibility "
+                "ETA and couplings truncated at SVD x operator_tol (1e-6), against the same "
+                "reference; the row's default for comparison."
+            )
+            lines.append("")
+            lines.append(
+                "| elements | variant | minimum film | central film | load | s "
+                "| default's minimum film | commit |"
+            )
+            lines.append("|---|---|---|---|---|---|---|---|")
+            for a, name in variants:
+                lines.append(
+                    f"| {a['elements']} | {name[len('fast_') :]} | {a[name + '_film_min']:.1e} | "
+                    f"{a[name + '_film_center']:.1e} | {a[name + '_load']:.1e} | {a[name + '_s']:.0f} | "
+                    f"{a['fast_film_min']:.1e} | {a.get('commit', '')} |"
                 )
             lines.append("")
     if tex is not None:
@@ -596,10 +680,20 @@ def main(argv=None) -> int:
     g.add_argument("--level", type=float, required=True)
     g.add_argument("--t-end", type=float, default=5.0)
     g.add_argument("--sources", action="store_true", help="also split the fast path's difference by source")
+    g.add_argument(
+        "--variant",
+        action="append",
+        default=[],
+        metavar="P:ETA:SVD",
+        help="experiment: also a fast run with this order, admissibility and truncation ratio",
+    )
     e = sub.add_parser("error", help="relative operator error against sampled exact rows")
     e.add_argument("--level", type=float, required=True)
     e.add_argument("--tols", type=float, nargs="*", default=[1e-6])
     e.add_argument("--rows", type=int, default=ERROR_ROWS)
+    e.add_argument("--vectors", type=int, default=ERROR_VECTORS, help="random vectors at once")
+    e.add_argument("--p", type=int, help="experiment: this Chebyshev order instead of the tolerance's")
+    e.add_argument("--svd-ratio", type=float, help="experiment: couplings truncated at this times tol")
     ap.add_argument("--levels", type=float, nargs="*", default=LEVELS)
     ap.add_argument("--dense-levels", type=float, nargs="*", default=DENSE_LEVELS)
     ap.add_argument("--agree-levels", type=float, nargs="*", default=[1.0, 0.5])
@@ -617,10 +711,10 @@ def main(argv=None) -> int:
     if a.cmd == "report":
         return _report(a.out)
     if a.cmd == "agree":
-        print(json.dumps(agree(a.level, a.t_end, a.sources)))
+        print(json.dumps(agree(a.level, a.t_end, a.sources, tuple(a.variant))))
         return 0
     if a.cmd == "error":
-        for rec in operator_error(a.level, a.tols, a.rows):
+        for rec in operator_error(a.level, a.tols, a.rows, a.vectors, a.p, a.svd_ratio):
             print(json.dumps(rec))
         return 0
     jsonl = a.out.with_suffix(".jsonl")

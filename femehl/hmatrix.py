@@ -45,7 +45,7 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from .validation import check_operator_tol
+from .validation import check_chebyshev_order, check_operator_tol, check_svd_ratio
 
 __all__ = [
     "ClusterTree",
@@ -252,11 +252,11 @@ class H2Operator:
     p : int, default: 9
         Chebyshev points per axis (:func:`order_for` gives it for a relative error).
     eta : float, default: 2.0
-        Admissibility: ``max(diam) <= eta dist``.
+        Admissibility: ``max(diam) <= eta dist`` (the fast compliance uses :data:`ETA`).
     leaf : int, default: 64
         Items per leaf cluster (64 and eta = 2 were the fastest and smallest of the
         tried (leaf, eta, p) = (32, 2, 9), (48, 2, 9), (32, 1.5, 8), (96, 2.5, 10) at the
-        same error).
+        same random-vector error; for the films' error eta = 2.5 at p = 11, :data:`ETA`).
     svd_tol : float, default: 1e-9
         Relative singular-value truncation of the interpolated blocks.
     factor_dtype : numpy dtype, default: float64
@@ -475,7 +475,7 @@ class H2Operator:
             del K
             r = np.maximum(1, (sv > svd_tol * sv[:, :1]).sum(axis=1))
             ranks.append(r)
-            bucket = np.minimum(-(-r // 4) * 4, pp)  # ranks rounded up to 4: batched products
+            bucket = np.minimum(-(-r // RANK_STEP) * RANK_STEP, pp)  # blocks grouped by rank
             for rb in np.unique(bucket):
                 sel = np.flatnonzero(bucket == rb)
                 # U^T (rank x pp) and V (rank x pp): both read along their last axis
@@ -591,37 +591,50 @@ class H2Operator:
 
 
 # ---- the compliance of a disk mesh ------------------------------------------------------
-#: relative operator error of the interpolation at p = 5 and its factor per extra order:
-#: ``_ERR_P5 / _ERR_FACTOR**(p - 5)`` bounds the error of a random vector (the
-#: Frobenius-like relative error, the largest of the vectors tried) measured against
-#: exact rows on the fitted paper-sphere half disks from 2,988 to 514,644 elements
-#: (``python benchmarks/fast_operator.py error``, ``benchmarks/fast_operator.md``), the
-#: couplings truncated at 0.1 tol: at p = 9 from 2.8e-7 (2,988) to 1.3e-6 (11,450),
-#: 1.0e-6 (47,296), 7.9e-7 (178,416), 1.1e-6 (514,644); at p = 10 2.4e-7 to 3.3e-7 from
-#: 11,450 on; at p = 12 7.9e-9 (2,988).  A smooth vector (a Hertz-like pressure) is 30
-#: times more accurate.  With the couplings truncated at tol (:data:`SVD_RATIO`) the
-#: default (p = 10) measures 1.9e-7 to 4.8e-7 over the same meshes.  These are single
-#: random vectors, which scatter by a factor of 5: with 64 (:func:`sampled_error`) on
-#: 11,450 elements p = 9 measures 5.3e-7 and p = 10 2.3e-7.  (Until 2026-12-04
-#: the law was fitted on 2,988 and 11,472 elements only, 1.3e-4 at p = 5, and gave p = 9
-#: at the default 1e-6.)
-_ERR_P5, _ERR_FACTOR = 3.4e-4, 4.0
+#: relative operator error of the interpolation at p = 5 and its factor per extra order
+#: (admissibility :data:`ETA` = 2.5, couplings at :data:`SVD_RATIO`):
+#: ``_ERR_P5 / _ERR_FACTOR**(p - 5)`` is the error of random vectors (the Frobenius ratio
+#: over 64, :func:`sampled_error`) against exact rows of the fitted paper-sphere half
+#: disks: 5.0e-7, 1.9e-7 and 1.1e-7 at p = 10, 11, 12 on 11,450 elements; 3.9e-7 at
+#: p = 11 on 47,296 (``benchmarks/fast_operator.md``).  A smooth vector (a Hertz-like
+#: pressure) is 20 to 30 times more accurate.
+_ERR_P5, _ERR_FACTOR = 6e-5, 2.6
+
+#: orders added to the law's for the films: the minimum film's relative error is the
+#: deflection's error at the thinnest film over the film there (about 0.02 against a
+#: deflection of order 1 in the paper case), so it magnifies the operator's error in those
+#: few rows.  Measured over the whole paper case at the default rtol against the dense
+#: operator solved to rtol 1e-10 (2,988 / 11,450 / 27,640 elements): p = 11 at eta = 2.5
+#: 8.7e-7 / 7.5e-7 / 7.9e-7; the law's own p = 10 (eta = 2, couplings at tol, the default
+#: until 2026-12-04) 1.5e-6 / 1.6e-6 / 2.1e-6
+FILM_ORDERS = 1
 
 
 def order_for(tol: float) -> int:
-    """Chebyshev points per axis for a relative operator error ``tol`` (eta = 2)."""
+    """Chebyshev points per axis for a relative operator error ``tol`` with films to about
+    ``tol`` (:data:`FILM_ORDERS` above the law's order; at most 14)."""
     need = math.log(max(_ERR_P5 / tol, 1.0)) / math.log(_ERR_FACTOR)
-    return int(min(14, 5 + math.ceil(need - 1e-9)))
+    return int(min(14, 5 + math.ceil(need - 1e-9) + FILM_ORDERS))
 
 
 #: the couplings' singular values are truncated at ``SVD_RATIO * operator_tol`` relative to
-#: each block's largest.  At the default p = 10 the interpolation error is 4 times below
-#: ``operator_tol``, so the truncation may take about as much: measured on 11,450 elements
-#: (sampled exact rows, one session) the error of a random vector is 2.9e-7, 3.2e-7 and
-#: 4.8e-7 at ratios 0.1, 0.3 and 1 (mean ranks 13.9, 12.4, 10.9; p = 9 at 0.1: 13.3 and
-#: 1.3e-6), and a whole paper-case step on 47,296 elements costs 261 and 223 ms at ratios
-#: 0.1 and 1 against 227 ms for p = 9 at 0.1 (``benchmarks/fast_operator.md``)
-SVD_RATIO = 1.0
+#: each block's largest.  The truncation, not the interpolation, set the minimum film's
+#: error at 1e-6: on 11,450 elements (p = 10, eta = 2, whole paper case, default rtol)
+#: 1.6e-6, 8.5e-7 and 9.0e-7 at ratios 1, 0.3 and 0.1 (27,640 elements: 2.1e-6 at 1,
+#: 1.5e-6 at 0.3), while a product ``C z`` on 47,296 elements costs the same at 1 and 0.3
+#: (40.2 and 41.4 ms, interleaved; mean ranks 11.3 and 12.9)
+SVD_RATIO = 0.3
+
+#: admissibility of the fast compliance: a block is far when ``max(diam) <= ETA dist``.
+#: At p = 11 (couplings at 0.3 tol) on 47,296 elements, eta = 2 / 2.5 / 3 keep 18.4 /
+#: 14.8 / 12.7 million near entries and a product costs 43.6 / 38.9 / 36.8 ms against the
+#: 37.8 ms of the former default (p = 10, eta = 2, couplings at tol); the minimum film on
+#: 27,640 elements is 6.5e-7 / 7.9e-7 / 6.5e-6 (eta = 3 needs p = 12: 8.2e-7, 41.4 ms)
+ETA = 2.5
+
+#: the couplings' ranks are rounded up to a multiple of this, blocks of one rank grouped
+#: (4 until 2026-12-04: 3 % more far-field bytes, the same time)
+RANK_STEP = 1
 
 #: the default ``operator_tol`` of the fast path (``femehl.solve(..., operator_tol=...)``)
 DEFAULT_OPERATOR_TOL = 1e-6
@@ -647,12 +660,27 @@ class FastCompliance:
     ``shape``, ``C *= factor``, ``nbytes``; and gives the sparse approximation the fast
     path's preconditioner factors, :attr:`preconditioner` (the near-field entries within
     :data:`PRECOND_RADIUS` element sizes, times ``P``).
+
+    ``p`` and ``svd_ratio`` override what ``tol`` gives (:func:`order_for`,
+    :data:`SVD_RATIO`): for experiments and benchmarks only, ``tol`` then still picks the
+    far factors' precision and the couplings are truncated at ``svd_ratio * tol``.
     """
 
     is_fast = True
 
-    def __init__(self, disc, tol: float = DEFAULT_OPERATOR_TOL, factor: float = 1.0, coarse: bool = True):
+    def __init__(
+        self,
+        disc,
+        tol: float = DEFAULT_OPERATOR_TOL,
+        factor: float = 1.0,
+        coarse: bool = True,
+        *,
+        p: int | None = None,
+        svd_ratio: float | None = None,
+    ):
         tol = check_operator_tol(tol)
+        p = order_for(tol) if p is None else check_chebyshev_order(p)
+        svd_ratio = SVD_RATIO if svd_ratio is None else check_svd_ratio(svd_ratio)
         t0 = time.perf_counter()
         ne = disc.nelements
         tri = disc.tri
@@ -662,6 +690,7 @@ class FastCompliance:
             tri = np.concatenate([tri, img])
             src_el = np.concatenate([src_el, src_el])
         self.tol = float(tol)
+        self.svd_ratio = float(svd_ratio)
         cen = disc.centroids
         radius = PRECOND_RADIUS * np.sqrt(np.abs(disc.areas))
 
@@ -682,10 +711,11 @@ class FastCompliance:
             tri,
             src_el,
             ne,
-            p=order_for(tol),
-            svd_tol=SVD_RATIO * self.tol,
+            p=p,
+            svd_tol=svd_ratio * self.tol,
             keep=keep,
             fold=P,
+            eta=ETA,
             factor_dtype=factor_dtype,
         )
         self.factor = float(factor)
@@ -702,7 +732,9 @@ class FastCompliance:
             m = min(COARSE_MAX, max(COARSE_MIN, P.shape[1] // COARSE_RATIO))
             self.coarse = self._coarse_space(disc, m)
             self.H.info.update(coarse_nodes=int(self.coarse[0].shape[1]), coarse_s=time.perf_counter() - t1)
-        self.info = dict(self.H.info, operator_tol=self.tol, build_s=time.perf_counter() - t0)
+        self.info = dict(
+            self.H.info, operator_tol=self.tol, svd_ratio=self.svd_ratio, build_s=time.perf_counter() - t0
+        )
 
     def _coarse_space(self, disc, m: int) -> tuple:
         """``(P, C P)`` of about ``m`` coarse nodes, ``C P`` by blocked products (set-up)."""

@@ -151,3 +151,17 @@ def check_operator_tol(value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not (1e-12 <= value < 0.1):
         raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {value!r}.")
     return float(value)
+
+
+def check_chebyshev_order(value) -> int:
+    """Chebyshev points per axis of the fast operator (an experiment's override): 2..16."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 2 <= value <= 16:
+        raise SceneError(f"the Chebyshev order p must be an integer in [2, 16], got {value!r}.")
+    return int(value)
+
+
+def check_svd_ratio(value) -> float:
+    """Truncation of the fast operator's couplings, relative to operator_tol: in (0, 1e3]."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < value <= 1e3):
+        raise SceneError(f"svd_ratio must be a number in (0, 1000], got {value!r}.")
+    return float(value)

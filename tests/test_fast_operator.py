@@ -93,6 +93,23 @@ def test_tighter_tolerance_is_more_accurate(sphere):
     assert order_for(1e-8) > order_for(1e-6) > order_for(1e-4)
 
 
+def test_truncation_and_order_overrides(sphere):
+    """The experiment overrides: a finer truncation keeps more rank and is no less
+    accurate against the dense operator; bad values get femehl's error naming the range."""
+    disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
+    dense = disc.boussinesq()
+    z = np.random.default_rng(5).standard_normal(disc.n)
+    coarse = FastCompliance(disc, coarse=False, svd_ratio=100.0)
+    fine = FastCompliance(disc, coarse=False, svd_ratio=0.01)
+    assert fine.info["svd_ratio"] == 0.01 and fine.H.p == order_for(1e-6)
+    assert fine.info["far_rank_mean"] > coarse.info["far_rank_mean"]
+    assert _rel(fine @ z, dense @ z) <= _rel(coarse @ z, dense @ z)
+    assert FastCompliance(disc, coarse=False, p=6).H.p == 6
+    for bad in ({"p": 1}, {"p": 9.5}, {"p": True}, {"svd_ratio": 0.0}, {"svd_ratio": float("nan")}):
+        with pytest.raises(SceneError, match="p must be|svd_ratio must be"):
+            FastCompliance(disc, coarse=False, **bad)
+
+
 def test_uniform_pressure_on_a_disk():
     """X 1 over a triangulated disk of radius a against 2 pi a (centre) and 4 a E(r^2/a^2).
 

@@ -39,8 +39,8 @@ ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_TH
 LEVELS = [1.0, 0.5, 0.32, 0.244, 0.177, 0.125, 0.0735]
 #: the dense path is run where it fits (femehl.fe.mesh.dense_bytes <= 80 % of the memory)
 DENSE_LEVELS = [1.0, 0.5, 0.32, 0.244]
-#: the tighter fast operator of the agreement runs (p = 11 instead of 10, double factors;
-#: 3e-7 until 2026-12-04: p = 10 then, against the default's 9)
+#: the tighter fast operator of the agreement runs (p = 13 against the default's 11, double
+#: factors; p = 11 against 10 until 4cb7e0f; 3e-7 before that: p = 10 against 9)
 TIGHT_OPERATOR_TOL = 1e-7
 
 
@@ -226,7 +226,7 @@ def operator_error(
     level: float,
     tols: list[float],
     rows: int = ERROR_ROWS,
-    vectors: int = ERROR_VECTORS,
+    n_vectors: int = ERROR_VECTORS,
     p: int | None = None,
     svd_ratio: float | None = None,
 ) -> list[dict]:
@@ -235,7 +235,7 @@ def operator_error(
     (:func:`femehl.hmatrix.sampled_error`): so it is measured where the dense operator
     does not fit.
 
-    For ``vectors`` random vectors at once (standard normal nodal values; the Frobenius
+    For ``n_vectors`` random vectors at once (standard normal nodal values; the Frobenius
     ratio over them: one vector's error scatters by a factor of 5) and a smooth one
     (``1 - r**2`` inside the unit circle, the shape of a Hertz pressure).  ``p`` and
     ``svd_ratio`` override the order and truncation the tolerance gives (experiment rows,
@@ -252,7 +252,7 @@ def operator_error(
     scene = _scene()
     disc = FEDisc(scene, mesh=fitted_disk(scene, 5.0, level), operator="fast")
     vectors = {
-        "random": np.random.default_rng(7).standard_normal((disc.n, vectors) if vectors > 1 else disc.n),
+        "random": np.random.default_rng(7).standard_normal((disc.n, n_vectors) if n_vectors > 1 else disc.n),
         "smooth": np.maximum(0.0, 1.0 - np.hypot(*disc.nodes[disc.free].T) ** 2),
     }
     out = []
@@ -269,7 +269,7 @@ def operator_error(
             {
                 **extra,
                 "kind": "operator_error",
-                "vectors": vectors,
+                "vectors": n_vectors,
                 "svd_ratio": C.svd_ratio,
                 "level": level,
                 "elements": disc.nelements,
@@ -595,8 +595,10 @@ def write(
             lines.append(
                 "Operator variants (`agree --variant P:ETA:SVD`, experiments): the fast path at "
                 "its default rtol with the operator built at Chebyshev order P, admissibility "
-                "ETA and couplings truncated at SVD x operator_tol (1e-6), against the same "
-                "reference; the row's default for comparison."
+                "ETA and couplings truncated at SVD x operator_tol (1e-6) at their exact ranks, "
+                "against the same reference; the row's default for comparison (p10_eta2_svd1 is "
+                "the default of 566eb3b to 82c2143 but for its ranks, rounded up to 4 there: 3 % "
+                "more far-field bytes)."
             )
             lines.append("")
             lines.append(

@@ -595,18 +595,20 @@ class H2Operator:
 #: (admissibility :data:`ETA` = 2.5, couplings at :data:`SVD_RATIO`):
 #: ``_ERR_P5 / _ERR_FACTOR**(p - 5)`` is the error of random vectors (the Frobenius ratio
 #: over 64, :func:`sampled_error`) against exact rows of the fitted paper-sphere half
-#: disks: 5.0e-7, 1.9e-7 and 1.1e-7 at p = 10, 11, 12 on 11,450 elements; 3.9e-7 at
-#: p = 11 on 47,296 (``benchmarks/fast_operator.md``).  A smooth vector (a Hertz-like
-#: pressure) is 20 to 30 times more accurate.
+#: disks: 5.0e-7, 1.9e-7 and 1.1e-7 at p = 10, 11, 12 on 11,450 elements (side runs);
+#: at p = 11 9.4e-8 (2,988) to 4.9e-7 (514,644, ``benchmarks/fast_operator.md``).  A
+#: smooth vector (a Hertz-like pressure) is 20 to 40 times more accurate.
 _ERR_P5, _ERR_FACTOR = 6e-5, 2.6
 
 #: orders added to the law's for the films: the minimum film's relative error is the
 #: deflection's error at the thinnest film over the film there (about 0.02 against a
 #: deflection of order 1 in the paper case), so it magnifies the operator's error in those
 #: few rows.  Measured over the whole paper case at the default rtol against the dense
-#: operator solved to rtol 1e-10 (2,988 / 11,450 / 27,640 elements): p = 11 at eta = 2.5
-#: 8.7e-7 / 7.5e-7 / 7.9e-7; the law's own p = 10 (eta = 2, couplings at tol, the default
-#: until 2026-12-04) 1.5e-6 / 1.6e-6 / 2.1e-6
+#: operator solved to rtol 1e-10 (2,988 / 11,450 / 27,640 elements,
+#: ``benchmarks/fast_operator.md``, agreement): p = 11 at eta = 2.5 6.4e-7 / 4.8e-7 /
+#: 7.2e-7 (side runs of the same: 8.7e-7 / 7.5e-7 / 7.9e-7, the preconditioner's refreshes
+#: follow measured times); p = 10 at eta = 2 with couplings at tol (the default until
+#: 2026-12-04) 1.5e-6 / 1.9e-6 / 2.2e-6
 FILM_ORDERS = 1
 
 
@@ -619,14 +621,14 @@ def order_for(tol: float) -> int:
 
 #: the couplings' singular values are truncated at ``SVD_RATIO * operator_tol`` relative to
 #: each block's largest.  The truncation, not the interpolation, set the minimum film's
-#: error at 1e-6: on 11,450 elements (p = 10, eta = 2, whole paper case, default rtol)
+#: error at 1e-6 (side runs, 2026-12-04): on 11,450 elements (p = 10, eta = 2, whole paper case, default rtol)
 #: 1.6e-6, 8.5e-7 and 9.0e-7 at ratios 1, 0.3 and 0.1 (27,640 elements: 2.1e-6 at 1,
 #: 1.5e-6 at 0.3), while a product ``C z`` on 47,296 elements costs the same at 1 and 0.3
 #: (40.2 and 41.4 ms, interleaved; mean ranks 11.3 and 12.9)
 SVD_RATIO = 0.3
 
 #: admissibility of the fast compliance: a block is far when ``max(diam) <= ETA dist``.
-#: At p = 11 (couplings at 0.3 tol) on 47,296 elements, eta = 2 / 2.5 / 3 keep 18.4 /
+#: At p = 11 (couplings at 0.3 tol) on 47,296 elements (side runs), eta = 2 / 2.5 / 3 keep 18.4 /
 #: 14.8 / 12.7 million near entries and a product costs 43.6 / 38.9 / 36.8 ms against the
 #: 37.8 ms of the former default (p = 10, eta = 2, couplings at tol); the minimum film on
 #: 27,640 elements is 6.5e-7 / 7.9e-7 / 6.5e-6 (eta = 3 needs p = 12: 8.2e-7, 41.4 ms)

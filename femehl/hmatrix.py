@@ -597,7 +597,7 @@ class H2Operator:
 #: over 64, :func:`sampled_error`) against exact rows of the fitted paper-sphere half
 #: disks: 5.0e-7, 1.9e-7 and 1.1e-7 at p = 10, 11, 12 on 11,450 elements (side runs);
 #: at p = 11 9.4e-8 (2,988) to 4.9e-7 (514,644, ``benchmarks/fast_operator.md``).  A
-#: smooth vector (a Hertz-like pressure) is 20 to 40 times more accurate.
+#: smooth vector (a Hertz-like pressure) is 10 to 40 times more accurate.
 _ERR_P5, _ERR_FACTOR = 6e-5, 2.6
 
 #: orders added to the law's for the films: the minimum film's relative error is the
@@ -621,17 +621,18 @@ def order_for(tol: float) -> int:
 
 #: the couplings' singular values are truncated at ``SVD_RATIO * operator_tol`` relative to
 #: each block's largest.  The truncation, not the interpolation, set the minimum film's
-#: error at 1e-6 (side runs, 2026-12-04): on 11,450 elements (p = 10, eta = 2, whole paper case, default rtol)
-#: 1.6e-6, 8.5e-7 and 9.0e-7 at ratios 1, 0.3 and 0.1 (27,640 elements: 2.1e-6 at 1,
-#: 1.5e-6 at 0.3), while a product ``C z`` on 47,296 elements costs the same at 1 and 0.3
-#: (40.2 and 41.4 ms, interleaved; mean ranks 11.3 and 12.9)
+#: error at 1e-6 (side runs, 2026-12-04; p = 10, eta = 2, whole paper case, default rtol):
+#: on 11,450 elements 1.6e-6, 8.5e-7 and 9.0e-7 at ratios 1, 0.3 and 0.1 (27,640
+#: elements: 2.1e-6 at 1, 1.5e-6 at 0.3), while a product ``C z`` on 47,296 elements costs
+#: the same at 1 and 0.3 (40.2 and 41.4 ms, interleaved; mean ranks 11.3 and 12.9)
 SVD_RATIO = 0.3
 
 #: admissibility of the fast compliance: a block is far when ``max(diam) <= ETA dist``.
-#: At p = 11 (couplings at 0.3 tol) on 47,296 elements (side runs), eta = 2 / 2.5 / 3 keep 18.4 /
-#: 14.8 / 12.7 million near entries and a product costs 43.6 / 38.9 / 36.8 ms against the
-#: 37.8 ms of the former default (p = 10, eta = 2, couplings at tol); the minimum film on
-#: 27,640 elements is 6.5e-7 / 7.9e-7 / 6.5e-6 (eta = 3 needs p = 12: 8.2e-7, 41.4 ms)
+#: At p = 11 (couplings at 0.3 tol) on 47,296 elements (side runs), eta = 2 / 2.5 / 3
+#: keep 18.4 / 14.8 / 12.7 million near entries and a product costs 43.6 / 38.9 / 36.8 ms
+#: against the 37.8 ms of the former default (p = 10, eta = 2, couplings at tol); the
+#: minimum film on 27,640 elements is 6.5e-7 / 7.9e-7 / 6.5e-6 (eta = 3 needs p = 12:
+#: 8.2e-7, 41.4 ms)
 ETA = 2.5
 
 #: the couplings' ranks are rounded up to a multiple of this, blocks of one rank grouped

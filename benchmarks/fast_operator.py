@@ -419,7 +419,14 @@ def write(
         for d in ok
         for f in ok
         if (d["operator"], f["operator"]) == ("dense", "fast")
-        and (f["elements"], f["steps"], f.get("commit")) == (d["elements"], d["steps"], d.get("commit"))
+        and (f["elements"], f["steps"]) == (d["elements"], d["steps"])
+        # one session: rows tagged with the dense run's session (fast runs of several
+        # commits beside it), else the rows of one commit
+        and (
+            f.get("session") == d["session"]
+            if d.get("session")
+            else (not f.get("session") and f.get("commit") == d.get("commit"))
+        )
     ]
     lines = [
         "# Fast (hierarchical) elastic operator against the dense one",
@@ -476,7 +483,10 @@ def write(
             )
         lines.append("")
     if pairs:
-        lines.append("Fast against dense on the same mesh (rows of one commit):")
+        lines.append(
+            "Fast against dense on the same mesh (rows of one commit, or of one session: fast runs "
+            "beside that dense run, named by their commit):"
+        )
         lines.append("")
         lines.append(
             "| elements | steps | time per step dense / fast | peak RSS dense / fast "
@@ -485,7 +495,8 @@ def write(
         lines.append("|---|---|---|---|---|")
         for d, f in pairs:
             lines.append(
-                f"| {d['elements']}{' (' + f['experiment'] + ')' if f.get('experiment') else ''} | "
+                f"| {d['elements']}{' (' + f['experiment'] + ')' if f.get('experiment') else ''}"
+                f"{' (' + f['commit'] + ', ' + f['session'] + ')' if f.get('session') else ''} | "
                 f"{d['steps']} | {d['ms_per_step'] / f['ms_per_step']:.2f} | "
                 f"{d['peak_rss'] / f['peak_rss']:.2f} | {d['operator_bytes'] / f['operator_bytes']:.2f} |"
             )

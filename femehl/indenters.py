@@ -493,7 +493,7 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     Indenter
         An instance of ``INDENTERS[kind]`` in normalized units.
     """
-    if kind not in INDENTERS:
+    if not isinstance(kind, str) or kind not in INDENTERS:
         raise SceneError(f"indenter kind {kind!r} is not known; use one of {sorted(INDENTERS)}.")
     cls = INDENTERS[kind]
     units = getattr(cls, "si_units", None)

@@ -123,7 +123,7 @@ def _build(registry, table, where, path):
         raise SceneFileError(f"{path}: [{where}] must be a table, got {table!r}.")
     table = dict(table)
     kind = table.pop("kind", None)
-    if kind not in registry:
+    if not isinstance(kind, str) or kind not in registry:
         raise SceneFileError(
             f"{path}: [{where}] kind = {kind!r} is not known; use one of {sorted(registry)}."
         )

@@ -108,6 +108,7 @@ class Roelands:
         """From the ambient viscosity ``eta0`` [Pa s], the Dimensional, ``Z`` and ``p0`` [Pa]."""
         eta0 = check_positive("eta0", eta0, "the ambient viscosity in Pa s.")
         p0 = check_positive("p0", p0, "Roelands' reference pressure, 1.96e8 Pa.")
+        Z = check_positive("Roelands Z", Z, "Z is about 0.6 for mineral oils (0 < Z <= 1.5).")
         A = math.log(eta0) + 9.67
         if A <= 0.0:
             raise SceneError(

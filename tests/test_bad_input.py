@@ -22,7 +22,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import femehl
@@ -336,8 +336,67 @@ def _load_and_use(path):
 
 @SLOW
 @given(doc=toml_documents())
+@example(doc="[indenter]\nkind = []\n")  # once a bare TypeError (an unhashable kind)
 def test_structured_scene_files(doc):
     _load_and_use(_scene_file(doc.encode()))
+
+
+#: Values of the wrong TOML type (arrays, inline tables, booleans, strings, non-finite and
+#: out-of-range numbers), put into every key femehl reads, one at a time.
+ODD_VALUES = ["[]", "{}", "[1, 2]", "[[1]]", "{a = 1}", "true", '"x"', "nan", "inf", "-1", "0", "1e400"]
+EVERY_KEY = {
+    "indenter": ["kind", "R", "Rx", "Ry", "a", "edge_radius", "file", "x", "y", "z", "symmetric_y"],
+    "substrate": ["kind", "nu", "k", "thickness", "bonded"],
+    "fluid": ["beta", "cavitation", "viscosity"],
+    "fluid.viscosity": ["kind", "alpha", "p_r", "Z"],
+    "domain": ["L"],
+    "run": sorted(femehl.scenefile.RUN_KEYS),
+    "motion": ["mass", "force", "hc_dot0", "load", "gap", "velocity"],
+    "motion.gap": ["kind", "h0", "h_end", "t1", "value", "times", "values"],
+    "motion.velocity": ["kind", "t1", "T", "V_ss", "value", "times", "values"],
+    "motion.load": ["kind", "value", "times", "values"],
+}
+KINDS_OF = {
+    "indenter": ["sphere", "ellipsoid", "flat_punch", "heightmap", "cylinder"],
+    "substrate": ["halfspace", "winkler", "rigid", "layer"],
+    "fluid.viscosity": ["barus", "roelands"],
+    "motion.gap": ["ramp_hold", "constant", "table"],
+    "motion.velocity": ["tanh", "constant", "table"],
+    "motion.load": ["constant", "table"],
+}
+SI_DOC = "R = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-5\nnu = 0.5\nh0 = 1e-4\n"
+SI_KEYS = ["R", "G", "eta", "V_ss", "h_inf", "nu", "h0", "t1", "T", "L", "load", "alpha", "roelands_Z"]
+SI_KEYS += ["layer_thickness", "G0", "tau", "G_inf", "mass", "force", "hc_dot0", "sliding", "cavitation"]
+
+
+def _load_only(doc):
+    path = _scene_file(doc.encode())
+    try:
+        run_options(load_scene_file(path)[1])
+    except FemehlError as exc:
+        assert_documented(exc)
+    except Exception as exc:  # noqa: BLE001 - the point: name the document that escaped
+        raise AssertionError(f"{type(exc).__name__}: {exc} from the scene file\n{doc}") from exc
+    finally:
+        path.unlink(missing_ok=True)
+
+
+@pytest.mark.parametrize("table", sorted(EVERY_KEY) + ["si"])
+def test_every_key_with_values_of_the_wrong_type(table):
+    """Deterministic complement of the random documents above: each key of ``table`` (of
+    each kind) set to each of ODD_VALUES loads or raises SceneFileError, never a bare
+    TypeError (``kind = []`` once did: an unhashable registry key; ``roelands_Z = []``
+    another)."""
+    for key in EVERY_KEY.get(table, SI_KEYS):
+        for value in ODD_VALUES:
+            if table == "si":
+                kept = [line for line in SI_DOC.splitlines() if not line.startswith(f"{key} ")]
+                _load_only("[si]\n" + "\n".join(kept) + f"\n{key} = {value}\n")
+                continue
+            _load_only(f"[{table}]\n{key} = {value}\n")
+            for kind in KINDS_OF.get(table, []) if key != "kind" else []:
+                _load_only(f'[{table}]\nkind = "{kind}"\n{key} = {value}\n')
+    _load_only(f"{table.split('.')[0]} = 1\n")
 
 
 @FAST

@@ -140,28 +140,15 @@ SOURCES = (
 )
 
 
-def _variant(spec: str):
-    """``"p:eta:svd_ratio"`` -> (name, a context that builds the fast operator so).
-
-    An experiment: the module constants femehl reads when it builds the operator
-    (``order_for``, ``ETA``, ``SVD_RATIO``) are swapped for one run and restored."""
-    import contextlib
-
-    import femehl.hmatrix as H
+def _variant(spec: str) -> tuple[str, dict]:
+    """``"p:eta:svd_ratio"`` -> (name, the run options that build the fast operator so:
+    ``operator_tol = FastOptions(p=p, eta=eta, svd_ratio=svd_ratio)``), an experiment."""
+    from femehl.hmatrix import FastOptions
 
     p, eta, ratio = spec.split(":")
     p, eta, ratio = int(p), float(eta), float(ratio)
-
-    @contextlib.contextmanager
-    def built():
-        saved = H.order_for, H.ETA, H.SVD_RATIO
-        H.order_for, H.ETA, H.SVD_RATIO = (lambda tol: p), eta, ratio
-        try:
-            yield
-        finally:
-            H.order_for, H.ETA, H.SVD_RATIO = saved
-
-    return f"fast_p{p}_eta{eta:g}_svd{ratio:g}", built
+    options = FastOptions(p=p, eta=eta, svd_ratio=ratio)
+    return f"fast_p{p}_eta{eta:g}_svd{ratio:g}", {"operator": "fast", "operator_tol": options}
 
 
 def agree(level: float, t_end: float, sources: bool = False, variants: tuple = ()) -> dict:
@@ -171,8 +158,6 @@ def agree(level: float, t_end: float, sources: bool = False, variants: tuple = (
     ``sources``, also the runs of :data:`SOURCES`; each of ``variants``
     (``"p:eta:svd_ratio"``, :func:`_variant`) a fast run at the default rtol with the
     operator built so."""
-    import contextlib
-
     import numpy as np
 
     import femehl
@@ -182,20 +167,18 @@ def agree(level: float, t_end: float, sources: bool = False, variants: tuple = (
     dm = fitted_disk(scene, 5.0, level)
     out = {"level": level, "t_end": t_end, "tight_operator_tol": TIGHT_OPERATOR_TOL}
     runs = {}
-    plain = contextlib.nullcontext
-    for name, opts, built in (
-        ("reference", {"operator": "dense", "rtol": 1e-10}, plain),
-        ("dense", {"operator": "dense"}, plain),
-        ("fast", {"operator": "fast"}, plain),
-        ("fast_tight", {"operator": "fast", "operator_tol": TIGHT_OPERATOR_TOL}, plain),
-        *((n, o, plain) for n, o in (SOURCES if sources else ())),
-        *((n, {"operator": "fast"}, b) for n, b in map(_variant, variants)),
+    for name, opts in (
+        ("reference", {"operator": "dense", "rtol": 1e-10}),
+        ("dense", {"operator": "dense"}),
+        ("fast", {"operator": "fast"}),
+        ("fast_tight", {"operator": "fast", "operator_tol": TIGHT_OPERATOR_TOL}),
+        *(SOURCES if sources else ()),
+        *map(_variant, variants),
     ):
         t0 = time.perf_counter()
-        with built():
-            runs[name] = femehl.solve(
-                scene, t_end=t_end, dt=0.01, mesh=dm, scheme="bdf2", estimate=False, store_every=0, **opts
-            )
+        runs[name] = femehl.solve(
+            scene, t_end=t_end, dt=0.01, mesh=dm, scheme="bdf2", estimate=False, store_every=0, **opts
+        )
         out[f"{name}_s"] = time.perf_counter() - t0
     out["elements"] = runs["fast"].info["elements"]
     for name, res in runs.items():  # the Chebyshev order each fast run's tolerance gave
@@ -229,6 +212,7 @@ def operator_error(
     n_vectors: int = ERROR_VECTORS,
     p: int | None = None,
     svd_ratio: float | None = None,
+    eta: float | None = None,
 ) -> list[dict]:
     """Relative error of the fast operator at each ``operator_tol`` on the fitted mesh of
     ``level``, against exact rows at ``rows`` elements drawn uniformly
@@ -237,9 +221,10 @@ def operator_error(
 
     For ``n_vectors`` random vectors at once (standard normal nodal values; the Frobenius
     ratio over them: one vector's error scatters by a factor of 5) and a smooth one
-    (``1 - r**2`` inside the unit circle, the shape of a Hertz pressure).  ``p`` and
-    ``svd_ratio`` override the order and truncation the tolerance gives (experiment rows,
-    tagged and not the default's).  One record per tolerance,
+    (``1 - r**2`` inside the unit circle, the shape of a Hertz pressure).  ``p``,
+    ``svd_ratio`` and ``eta`` override the order, truncation and admissibility of the
+    default (:class:`femehl.hmatrix.FastOptions`; experiment rows, tagged and not the
+    default's).  One record per tolerance,
     with the Chebyshev order, the far factors' precision, the build seconds and bytes of
     the operator (the preconditioner's coarse space is not built).
     """
@@ -247,7 +232,7 @@ def operator_error(
 
     from femehl.discretizations.fe_disk import FEDisc
     from femehl.fe.fitted import fitted_disk
-    from femehl.hmatrix import FastCompliance, sampled_error
+    from femehl.hmatrix import FastCompliance, FastOptions, sampled_error
 
     scene = _scene()
     disc = FEDisc(scene, mesh=fitted_disk(scene, 5.0, level), operator="fast")
@@ -258,13 +243,12 @@ def operator_error(
     out = []
     for tol in tols:
         t0 = time.perf_counter()
-        C = FastCompliance(disc, tol=tol, coarse=False, p=p, svd_ratio=svd_ratio)
+        overrides = {k: v for k, v in (("p", p), ("svd_ratio", svd_ratio), ("eta", eta)) if v is not None}
+        C = FastCompliance(disc, FastOptions(tol=tol, **overrides), coarse=False)
         build = time.perf_counter() - t0
         extra = {}
-        if p is not None or svd_ratio is not None:
-            extra["experiment"] = ", ".join(
-                f"{k}={v:g}" for k, v in (("p", p), ("svd_ratio", svd_ratio)) if v is not None
-            )
+        if overrides:
+            extra["experiment"] = ", ".join(f"{k}={v:g}" for k, v in overrides.items())
         out.append(
             {
                 **extra,
@@ -707,6 +691,7 @@ def main(argv=None) -> int:
     e.add_argument("--vectors", type=int, default=ERROR_VECTORS, help="random vectors at once")
     e.add_argument("--p", type=int, help="experiment: this Chebyshev order instead of the tolerance's")
     e.add_argument("--svd-ratio", type=float, help="experiment: couplings truncated at this times tol")
+    e.add_argument("--eta", type=float, help="experiment: this admissibility instead of the default's")
     ap.add_argument("--levels", type=float, nargs="*", default=LEVELS)
     ap.add_argument("--dense-levels", type=float, nargs="*", default=DENSE_LEVELS)
     ap.add_argument("--agree-levels", type=float, nargs="*", default=[1.0, 0.5])
@@ -727,7 +712,7 @@ def main(argv=None) -> int:
         print(json.dumps(agree(a.level, a.t_end, a.sources, tuple(a.variant))))
         return 0
     if a.cmd == "error":
-        for rec in operator_error(a.level, a.tols, a.rows, a.vectors, a.p, a.svd_ratio):
+        for rec in operator_error(a.level, a.tols, a.rows, a.vectors, a.p, a.svd_ratio, a.eta):
             print(json.dumps(rec))
         return 0
     jsonl = a.out.with_suffix(".jsonl")

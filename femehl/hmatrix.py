@@ -45,11 +45,19 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from .validation import check_chebyshev_order, check_operator_tol, check_svd_ratio
+from .errors import SceneError
+from .validation import (
+    check_admissibility,
+    check_chebyshev_order,
+    check_int,
+    check_operator_tol,
+    check_svd_ratio,
+)
 
 __all__ = [
     "ClusterTree",
     "FastCompliance",
+    "FastOptions",
     "H2Operator",
     "cluster_tree",
     "order_for",
@@ -259,6 +267,9 @@ class H2Operator:
         same random-vector error; for the films' error eta = 2.5 at p = 11, :data:`ETA`).
     svd_tol : float, default: 1e-9
         Relative singular-value truncation of the interpolated blocks.
+    rank_step : int, default: :data:`RANK_STEP`
+        The blocks' ranks rounded up to a multiple of this (blocks of one rank are
+        grouped for the product).
     factor_dtype : numpy dtype, default: float64
         Storage of the blocks' low-rank factors (``float32``: half the memory and half
         the far field's time; a relative rounding of about 6e-8 of each factor, measured
@@ -286,9 +297,11 @@ class H2Operator:
         keep=None,
         fold=None,
         factor_dtype=np.float64,
+        rank_step=None,
     ):
         t0 = time.perf_counter()
         self.p, self.eta, self.leaf = int(p), float(eta), int(leaf)
+        self.rank_step = RANK_STEP if rank_step is None else int(rank_step)
         self.factor_dtype = np.dtype(factor_dtype)
         targets = np.asarray(targets, dtype=float)
         tri = np.asarray(tri, dtype=float)
@@ -324,6 +337,7 @@ class H2Operator:
             "p": self.p,
             "eta": self.eta,
             "leaf": self.leaf,
+            "rank_step": self.rank_step,
             "far_blocks": int(self.n_far),
             "near_blocks": int(self.n_near),
             "near_nnz": int(self._near_perm.nnz),
@@ -475,7 +489,7 @@ class H2Operator:
             del K
             r = np.maximum(1, (sv > svd_tol * sv[:, :1]).sum(axis=1))
             ranks.append(r)
-            bucket = np.minimum(-(-r // RANK_STEP) * RANK_STEP, pp)  # blocks grouped by rank
+            bucket = np.minimum(-(-r // self.rank_step) * self.rank_step, pp)  # blocks grouped by rank
             for rb in np.unique(bucket):
                 sel = np.flatnonzero(bucket == rb)
                 # U^T (rank x pp) and V (rank x pp): both read along their last axis
@@ -656,6 +670,68 @@ PRECOND_RADIUS = 4.0
 COARSE_RATIO, COARSE_MIN, COARSE_MAX = 12, 100, 600
 
 
+@dataclass(frozen=True)
+class FastOptions:
+    """How :class:`FastCompliance` is built: one tolerance, and the overrides of experiments.
+
+    ``femehl.solve(..., operator_tol=x)`` is ``FastOptions(tol=x)``; a ``FastOptions``
+    may be given as ``operator_tol`` instead to build another operator (benchmarks and
+    experiments: ``benchmarks/fast_operator.py agree --variant``).
+
+    Parameters
+    ----------
+    tol : float, default: :data:`DEFAULT_OPERATOR_TOL`
+        Relative operator error; gives the Chebyshev order (:func:`order_for`) and the
+        far factors' precision (single from :data:`SINGLE_FACTORS_TOL`).
+    p : int, optional
+        Chebyshev points per axis instead of ``order_for(tol)`` (2 to 16).
+    eta : float, default: :data:`ETA`
+        Admissibility: a block is far when ``max(diam) <= eta dist``.
+    svd_ratio : float, default: :data:`SVD_RATIO`
+        The couplings are truncated at ``svd_ratio * tol``.
+    rank_step : int, default: :data:`RANK_STEP`
+        The couplings' ranks rounded up to a multiple of this.
+    """
+
+    tol: float = DEFAULT_OPERATOR_TOL
+    p: int | None = None
+    eta: float = ETA
+    svd_ratio: float = SVD_RATIO
+    rank_step: int = RANK_STEP
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "tol", check_operator_tol(self.tol))
+        set_(self, "p", None if self.p is None else check_chebyshev_order(self.p))
+        set_(self, "eta", check_admissibility(self.eta))
+        set_(self, "svd_ratio", check_svd_ratio(self.svd_ratio))
+        set_(self, "rank_step", check_int("rank_step", self.rank_step, 1, "Ranks are rounded up to it."))
+
+    @classmethod
+    def of(cls, value) -> FastOptions:
+        """``value`` if it is a FastOptions, else ``FastOptions(tol=value)`` (SceneError
+        naming ``operator_tol`` if it is neither)."""
+        if isinstance(value, cls):
+            return value
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
+            raise SceneError(
+                f"operator_tol must be a number in [1e-12, 0.1) or a femehl.hmatrix.FastOptions, "
+                f"got {value!r}."
+            )
+        return cls(tol=float(value))
+
+    @property
+    def order(self) -> int:
+        """The Chebyshev order: ``p``, or what ``tol`` gives (:func:`order_for`)."""
+        return order_for(self.tol) if self.p is None else self.p
+
+    @property
+    def factor_dtype(self):
+        """The far factors' storage: single precision when their rounding (6e-8) is far
+        below ``tol`` (from :data:`SINGLE_FACTORS_TOL`)."""
+        return np.float32 if self.tol >= SINGLE_FACTORS_TOL else np.float64
+
+
 class FastCompliance:
     """``C = factor * X P`` of a disk mesh with ``X`` as an :class:`H2Operator` (never dense).
 
@@ -664,26 +740,13 @@ class FastCompliance:
     path's preconditioner factors, :attr:`preconditioner` (the near-field entries within
     :data:`PRECOND_RADIUS` element sizes, times ``P``).
 
-    ``p`` and ``svd_ratio`` override what ``tol`` gives (:func:`order_for`,
-    :data:`SVD_RATIO`): for experiments and benchmarks only, ``tol`` then still picks the
-    far factors' precision and the couplings are truncated at ``svd_ratio * tol``.
+    ``options``: a :class:`FastOptions`, or its tolerance alone (a number).
     """
 
     is_fast = True
 
-    def __init__(
-        self,
-        disc,
-        tol: float = DEFAULT_OPERATOR_TOL,
-        factor: float = 1.0,
-        coarse: bool = True,
-        *,
-        p: int | None = None,
-        svd_ratio: float | None = None,
-    ):
-        tol = check_operator_tol(tol)
-        p = order_for(tol) if p is None else check_chebyshev_order(p)
-        svd_ratio = SVD_RATIO if svd_ratio is None else check_svd_ratio(svd_ratio)
+    def __init__(self, disc, options=None, factor: float = 1.0, coarse: bool = True):
+        options = FastOptions() if options is None else FastOptions.of(options)
         t0 = time.perf_counter()
         ne = disc.nelements
         tri = disc.tri
@@ -692,8 +755,9 @@ class FastCompliance:
             img = tri * np.array([1.0, -1.0])
             tri = np.concatenate([tri, img])
             src_el = np.concatenate([src_el, src_el])
-        self.tol = float(tol)
-        self.svd_ratio = float(svd_ratio)
+        self.options = options
+        self.tol = options.tol
+        self.svd_ratio = options.svd_ratio
         cen = disc.centroids
         radius = PRECOND_RADIUS * np.sqrt(np.abs(disc.areas))
 
@@ -701,12 +765,12 @@ class FastCompliance:
             e = src_el[j]
             return np.hypot(*(cen[i] - cen[e]).T) <= radius[e]
 
-        # the far factors in single precision when their rounding (6e-8) is far below tol:
-        # half the far field's memory and time.  Products and sums stay in double
-        # (_couple), so the operator is one fixed linear map: no rounding floor under the
-        # Krylov residual (single-precision *arithmetic* put one at about 1e-7)
-        factor_dtype = np.float32 if self.tol >= SINGLE_FACTORS_TOL else np.float64
-        # the element average P folded into the near field: about half the entries of
+        # the far factors in single precision when their rounding (6e-8) is far below tol
+        # (FastOptions.factor_dtype): half the far field's memory and time.  Products and
+        # sums stay in double (_couple), so the operator is one fixed linear map: no
+        # rounding floor under the Krylov residual (single-precision *arithmetic* put one
+        # at about 1e-7).
+        # The element average P folded into the near field: about half the entries of
         # X_near (an element's ~800 near elements share ~400 nodes), so half the work
         P = disc.P[:, disc.free].tocsr()
         self.H = H2Operator(
@@ -714,12 +778,13 @@ class FastCompliance:
             tri,
             src_el,
             ne,
-            p=p,
-            svd_tol=svd_ratio * self.tol,
+            p=options.order,
+            svd_tol=options.svd_ratio * options.tol,
             keep=keep,
             fold=P,
-            eta=ETA,
-            factor_dtype=factor_dtype,
+            eta=options.eta,
+            factor_dtype=options.factor_dtype,
+            rank_step=options.rank_step,
         )
         self.factor = float(factor)
         rows, cols, vals = self.H.kept

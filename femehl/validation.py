@@ -165,3 +165,10 @@ def check_svd_ratio(value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < value <= 1e3):
         raise SceneError(f"svd_ratio must be a number in (0, 1000], got {value!r}.")
     return float(value)
+
+
+def check_admissibility(value) -> float:
+    """Admissibility of the fast operator's far blocks (an experiment's override): in [0.5, 10]."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.5 <= value <= 10.0):
+        raise SceneError(f"the admissibility eta must be a number in [0.5, 10], got {value!r}.")
+    return float(value)

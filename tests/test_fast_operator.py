@@ -22,7 +22,7 @@ import femehl
 from femehl.discretizations.fe_disk import FEDisc
 from femehl.errors import SceneError
 from femehl.fe.fitted import fitted_disk
-from femehl.hmatrix import FastCompliance, H2Operator, order_for, sampled_error
+from femehl.hmatrix import FastCompliance, FastOptions, H2Operator, order_for, sampled_error
 from femehl.kernels import triangle_influence
 from femehl.presets import paper_sphere
 
@@ -81,7 +81,7 @@ def test_single_precision_factors_keep_one_linear_map(sphere):
     # double rounding of a sum over ~10^4 terms: far below single precision (6e-8)
     assert _rel(fast @ (a + 2.0 * b), fast @ a + 2.0 * (fast @ b)) <= 1e-13
     assert _rel(fast @ np.column_stack([a, b])[:, 1], fast @ b) <= 1e-13
-    tight = FastCompliance(disc, tol=1e-8)
+    tight = FastCompliance(disc, 1e-8)
     assert {V.dtype for *_, V in tight.H._far_groups} == {np.dtype(np.float64)}
 
 
@@ -89,27 +89,40 @@ def test_tighter_tolerance_is_more_accurate(sphere):
     disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
     dense = disc.boussinesq()
     z = np.random.default_rng(5).standard_normal(disc.n)
-    errs = {tol: _rel(FastCompliance(disc, tol=tol) @ z, dense @ z) for tol in (1e-4, 1e-8)}
+    errs = {tol: _rel(FastCompliance(disc, tol) @ z, dense @ z) for tol in (1e-4, 1e-8)}
     assert errs[1e-4] <= 1e-4
     assert errs[1e-8] <= 1e-8
     assert order_for(1e-8) > order_for(1e-6) > order_for(1e-4)
 
 
 def test_truncation_and_order_overrides(sphere):
-    """The experiment overrides: a finer truncation keeps more rank and is no less
-    accurate against the dense operator; bad values get femehl's error naming the range."""
+    """The experiment overrides (:class:`FastOptions`): a finer truncation keeps more rank
+    and is no less accurate against the dense operator; a larger admissibility keeps fewer
+    near entries; ranks rounded up to a step are no fewer; they reach the operator through
+    ``operator_tol``; bad values get femehl's error naming the range."""
     disc = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 1.0), operator="dense")
     dense = disc.boussinesq()
     z = np.random.default_rng(5).standard_normal(disc.n)
-    coarse = FastCompliance(disc, coarse=False, svd_ratio=100.0)
-    fine = FastCompliance(disc, coarse=False, svd_ratio=0.01)
+    coarse = FastCompliance(disc, FastOptions(svd_ratio=100.0), coarse=False)
+    fine = FastCompliance(disc, FastOptions(svd_ratio=0.01), coarse=False)
     assert fine.info["svd_ratio"] == 0.01 and fine.H.p == order_for(1e-6)
     assert fine.info["far_rank_mean"] > coarse.info["far_rank_mean"]
     assert _rel(fine @ z, dense @ z) <= _rel(coarse @ z, dense @ z)
-    assert FastCompliance(disc, coarse=False, p=6).H.p == 6
-    for bad in ({"p": 1}, {"p": 9.5}, {"p": True}, {"svd_ratio": 0.0}, {"svd_ratio": float("nan")}):
-        with pytest.raises(SceneError, match="p must be|svd_ratio must be"):
-            FastCompliance(disc, coarse=False, **bad)
+    assert FastCompliance(disc, FastOptions(p=6), coarse=False).H.p == 6
+    wide = FastCompliance(disc, FastOptions(eta=4.0), coarse=False)
+    assert wide.info["eta"] == 4.0 and wide.info["near_nnz"] < fine.info["near_nnz"]
+    stepped = FastCompliance(disc, FastOptions(rank_step=8), coarse=False)
+    assert stepped.info["rank_step"] == 8 and stepped.H.nbytes > FastCompliance(disc, coarse=False).H.nbytes
+    mesh = fitted_disk(sphere, 5.0, 1.0)
+    via_solve = FEDisc(sphere, mesh=mesh, operator="fast", operator_tol=FastOptions(p=7))
+    assert via_solve.boussinesq().H.p == 7 and via_solve.operator_tol == 1e-6
+    bad = ({"p": 1}, {"p": 9.5}, {"p": True}, {"svd_ratio": 0.0}, {"svd_ratio": float("nan")}, {"eta": 0.1})
+    for kwargs in bad + ({"eta": "2"}, {"rank_step": 0}, {"tol": 1.0}):
+        with pytest.raises(SceneError, match="p must|svd_ratio must|eta must|rank_step must|operator_tol"):
+            FastOptions(**kwargs)
+    for value in ("small", True, [1e-6]):
+        with pytest.raises(SceneError, match="operator_tol must be"):
+            FastCompliance(disc, value)
 
 
 def test_uniform_pressure_on_a_disk():

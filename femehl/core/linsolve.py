@@ -66,6 +66,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SceneError, SingularSystemError
+from ..validation import check_positive
 
 __all__ = [
     "StepOperator",
@@ -652,11 +653,8 @@ class RecycledGCR:
         max_krylov: int | None = None,
     ):
         if rtol is not None:
-            try:
-                rtol = float(rtol)
-            except (TypeError, ValueError):
-                rtol = float("nan")
-            if not (0.0 < rtol < 1e-2):
+            rtol = check_positive("rtol", rtol, "The Krylov tolerance is a number in (0, 1e-2), or None.")
+            if rtol >= 1e-2:
                 raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
         if refactor_after is not None and (
             isinstance(refactor_after, bool) or not isinstance(refactor_after, int) or refactor_after < 1

@@ -25,7 +25,7 @@ from skfem import Basis, ElementTriP0, ElementTriP1
 from ..errors import SceneError
 from ..fe.fitted import fitted_disk
 from ..fe.mesh import areas, centroids, load_mesh
-from ..hmatrix import DEFAULT_OPERATOR_TOL
+from ..hmatrix import DEFAULT_OPERATOR_TOL, FastOptions
 from ..kernels import (
     edge_terms,
     mesh_edges,
@@ -38,7 +38,6 @@ from ..kernels import (
     triangle_influence,
 )
 from ..substrates.base import OPERATORS, substrate_operators
-from ..validation import check_operator_tol
 from . import register_method
 from ._p1p0 import P1P0
 
@@ -84,8 +83,9 @@ class FEDisc(P1P0):
         preconditioned with a sparse LU of the near field).  "auto": fast from
         :data:`FAST_CROSSOVER` elements on, or when the dense operator does not fit in
         memory.
-    operator_tol : float, default: :data:`femehl.hmatrix.DEFAULT_OPERATOR_TOL`
-        Relative error of the fast operator (sets its interpolation order).
+    operator_tol : float or femehl.hmatrix.FastOptions, default: :data:`femehl.hmatrix.DEFAULT_OPERATOR_TOL`
+        Relative error of the fast operator (sets its interpolation order); a
+        :class:`~femehl.hmatrix.FastOptions` builds it with other parameters (experiments).
     """
 
     dimension = 2
@@ -99,19 +99,19 @@ class FEDisc(P1P0):
         mesh="medium",
         half: bool | None = None,
         operator: str = "auto",
-        operator_tol: float = DEFAULT_OPERATOR_TOL,
+        operator_tol: float | FastOptions = DEFAULT_OPERATOR_TOL,
     ):
         t0 = time.perf_counter()
         if not isinstance(operator, str) or operator not in OPERATORS:
             raise SceneError(f"operator must be one of {', '.join(map(repr, OPERATORS))}, got {operator!r}.")
-        operator_tol = check_operator_tol(operator_tol)
+        fast_options = FastOptions.of(operator_tol)
         self.scene = scene
         symmetric = bool(getattr(scene.indenter, "symmetric_y", False))
         if half is not None and not isinstance(half, (bool, np.bool_)):
             raise SceneError(f"half must be True, False or None (automatic), got {half!r}.")
         if half is None:
             half = symmetric if isinstance(mesh, str) and not _looks_like_path(mesh) else None
-            half = symmetric if mesh == FITTED else half
+            half = symmetric if isinstance(mesh, str) and mesh == FITTED else half
         if half and not symmetric:
             raise SceneError(
                 "a half-disk mesh needs an indenter symmetric in y; use half=False or a full-disk mesh."
@@ -146,7 +146,8 @@ class FEDisc(P1P0):
         self.load_weights = mult * self.node_weight[self.free]
         self._finder_ = None
         self.operator = self._resolve_operator(operator, ne)
-        self.operator_tol = operator_tol
+        self.fast_options = fast_options
+        self.operator_tol = fast_options.tol
         self.info = {
             "mesh": dm.name,
             "half": dm.half,
@@ -236,7 +237,7 @@ class FEDisc(P1P0):
         if self.operator == "fast":
             from ..hmatrix import FastCompliance
 
-            return FastCompliance(self, tol=self.operator_tol)
+            return FastCompliance(self, self.fast_options)
         return self._dense_boussinesq()
 
     def _dense_boussinesq(self):

@@ -312,6 +312,47 @@ def textured(elements: int, t_end: float, out: str) -> dict:
     return figures
 
 
+#: fitted-mesh levels around the crossover of operator="auto" (5,766 / 7,998 / 11,450 elements)
+CROSSOVER_LEVELS = [0.71, 0.6, 0.5]
+
+
+def crossover(levels: list[float], rounds: int, timeout: float) -> list[dict]:
+    """The whole paper case (``case --steps 500``, set-up included) with the dense and the
+    fast operator in turn, ``rounds`` times each, in their own processes: one record per
+    level with every process's wall seconds (start-up and imports included), the medians
+    and the median of the pairs' fast / dense ratios (pairs in turn, so the ratio holds
+    while the machine's speed drifts)."""
+    import statistics
+
+    out = []
+    for level in levels:
+        walls, elements = {"dense": [], "fast": []}, None
+        for _ in range(rounds):
+            for op in ("dense", "fast"):
+                t0 = time.perf_counter()
+                r = _run(["case", "--level", str(level), "--operator", op, "--steps", "500"], timeout)
+                if "error" in r:
+                    raise SystemExit(f"crossover: {op} at level {level} failed: {r['error']}")
+                walls[op].append(time.perf_counter() - t0)
+                elements = r["elements"]
+        ratios = [f / d for d, f in zip(walls["dense"], walls["fast"], strict=True)]
+        out.append(
+            {
+                "kind": "crossover",
+                "level": level,
+                "elements": elements,
+                "dense_s": walls["dense"],
+                "fast_s": walls["fast"],
+                "dense_median_s": statistics.median(walls["dense"]),
+                "fast_median_s": statistics.median(walls["fast"]),
+                "fast_over_dense": statistics.median(ratios),
+                "commit": _head(),
+            }
+        )
+        print(json.dumps(out[-1]), flush=True)
+    return out
+
+
 def _run(args: list[str], timeout: float) -> dict | None:
     try:
         p = subprocess.run(
@@ -385,6 +426,7 @@ def write(
     path_png: Path,
     tex: dict | None = None,
     errors: list[dict] = (),
+    crossings: list[dict] = (),
 ) -> None:
     import numpy as np
 
@@ -425,34 +467,36 @@ def write(
         "the 44,792-element rows of 93f7c14 and the 47,296-element rows of 3e0e5c7: "
         "dense on one core, fast and other runs on the other, at the same time)." + _commits(rows),
         "",
+    ]
+    header = [
         "| operator | elements | set-up s | ms / step | Krylov / step (max) | operator bytes / element "
         "| peak RSS GiB | steps | commit |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
-    for r in sorted(ok, key=lambda r: (r["steps"], r["elements"], r["operator"])):
-        lines.append(
+
+    def row(r):
+        return (
             f"| {r['operator']} | {r['elements']} | {r['setup_s']:.1f} | {r['ms_per_step']:.0f} | "
             f"{r['krylov_per_step']:.1f} ({r['krylov_max']}) | {r['operator_bytes'] / r['elements']:.0f} | "
             f"{r['peak_rss'] / 2**30:.2f} | {r['steps']} | {r.get('commit', '')}{_experiment(r)} |"
         )
-    for r in ok:
-        if r.get("note"):
-            lines.append(f"| ({r['elements']}: {r['note']}) |  |  |  |  |  |  |  |  |")
-    for r in rows:
-        if "error" in r:
-            lines.append(f"| failed | {' '.join(r['args'])} | {r['error'][-200:]!r} |  |  |  |  |  |")
-    lines.append("")
+
     if len(fast) >= 3:
         n = [r["elements"] for r in fast]
-        lines.append(
+        lines += [
+            f"## The fast ladder (commit {fast[-1].get('commit')}, one session, fitted below)",
+            "",
+            *header,
+            *map(row, fast),
+            "",
             f"Fitted exponents over the fast ladder ({n[0]} to {n[-1]} elements, commit "
             f"{fast[-1].get('commit')}): time per step "
             f"N^{fit_exponent(n, [r['ms_per_step'] for r in fast]):.2f}, set-up "
             f"N^{fit_exponent(n, [r['setup_s'] for r in fast]):.2f}, operator bytes "
             f"N^{fit_exponent(n, [r['operator_bytes'] for r in fast]):.2f}, peak RSS "
             f"N^{fit_exponent(n, [r['peak_rss'] for r in fast]):.2f} (N log N fitted the same way: "
-            f"N^{fit_exponent(n, [k * math.log(k) for k in n]):.2f})."
-        )
+            f"N^{fit_exponent(n, [k * math.log(k) for k in n]):.2f}).",
+        ]
         big = [r for r in fast if r["elements"] >= 20_000]
         if len(big) >= 3:
             nb = [r["elements"] for r in big]
@@ -465,7 +509,17 @@ def write(
                 f"per Krylov iteration N^{fit_exponent(nb, per_it):.2f}, Krylov iterations per step "
                 f"{big[0]['krylov_per_step']:.1f} -> {big[-1]['krylov_per_step']:.1f}."
             )
-        lines.append("")
+        lines += ["", "## Every recorded run (earlier operators and sessions included)", ""]
+    lines += header
+    for r in sorted(ok, key=lambda r: (r["steps"], r["elements"], r["operator"])):
+        lines.append(row(r))
+    for r in ok:
+        if r.get("note"):
+            lines.append(f"| ({r['elements']}: {r['note']}) |  |  |  |  |  |  |  |  |")
+    for r in rows:
+        if "error" in r:
+            lines.append(f"| failed | {' '.join(r['args'])} | {r['error'][-200:]!r} |  |  |  |  |  |")
+    lines.append("")
     if pairs:
         lines.append(
             "Fast against dense on the same mesh (rows of one commit, or of one session: fast runs "
@@ -608,6 +662,22 @@ def write(
                     f"{a['fast_film_min']:.1e} | {a.get('commit', '')} |"
                 )
             lines.append("")
+    if crossings:
+        lines += [
+            'Crossover of `operator="auto"` (`crossover`): the whole paper case (500 steps, set-up '
+            "included) with each operator in its own process, dense and fast in turn; wall seconds of "
+            "the processes (start-up and imports included), medians, and the median of the pairs' "
+            "fast / dense ratios (below 1: the fast path is cheaper).",
+            "",
+            "| elements | dense s (median) | fast s (median) | fast / dense | runs each | commit |",
+            "|---|---|---|---|---|---|",
+        ]
+        for c in sorted(crossings, key=lambda c: (c.get("commit") or "", c["elements"])):
+            lines.append(
+                f"| {c['elements']} | {c['dense_median_s']:.1f} | {c['fast_median_s']:.1f} | "
+                f"{c['fast_over_dense']:.2f} | {len(c['dense_s'])} | {c.get('commit', '')} |"
+            )
+        lines.append("")
     if tex is not None:
         lines.append(
             "The textured example (`examples/textured_sphere.py`: dimpled sphere, full disk, "
@@ -673,6 +743,9 @@ def main(argv=None) -> int:
     x.add_argument("--elements", type=int, default=200_000)
     x.add_argument("--t-end", type=float, default=5.0)
     x.add_argument("--out", default="femehl-out/textured_sphere")
+    x2 = sub.add_parser("crossover", help="whole paper case, dense and fast in turn, around the crossover")
+    x2.add_argument("--at", type=float, nargs="*", default=CROSSOVER_LEVELS, help="levels")
+    x2.add_argument("--rounds", type=int, default=3)
     g = sub.add_parser("agree")
     g.add_argument("--level", type=float, required=True)
     g.add_argument("--t-end", type=float, default=5.0)
@@ -708,6 +781,11 @@ def main(argv=None) -> int:
         return 0
     if a.cmd == "report":
         return _report(a.out)
+    if a.cmd == "crossover":
+        with a.out.with_suffix(".jsonl").open("a") as fh:
+            for rec in crossover(a.at, a.rounds, a.timeout):
+                fh.write(json.dumps(rec) + "\n")
+        return _report(a.out)
     if a.cmd == "agree":
         print(json.dumps(agree(a.level, a.t_end, a.sources, tuple(a.variant))))
         return 0
@@ -741,14 +819,15 @@ def main(argv=None) -> int:
 
 
 def _report(out: Path) -> int:
-    rows, agreements, errors = [], [], []
+    rows, agreements, errors, crossings = [], [], [], []
     for line in out.with_suffix(".jsonl").read_text().splitlines():
         r = json.loads(line)
         kind = r.get("kind")
-        (agreements if kind == "agree" else errors if kind == "operator_error" else rows).append(r)
+        into = {"agree": agreements, "operator_error": errors, "crossover": crossings}.get(kind, rows)
+        into.append(r)
     tex_path = HERE / "fast_operator_textured.json"
     tex = json.loads(tex_path.read_text()) if tex_path.is_file() else None
-    write(rows, agreements, out.with_suffix(".md"), out.with_suffix(".png"), tex, errors)
+    write(rows, agreements, out.with_suffix(".md"), out.with_suffix(".png"), tex, errors, crossings)
     return 0
 
 

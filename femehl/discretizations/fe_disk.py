@@ -49,8 +49,9 @@ FITTED = "fitted"
 
 #: "auto" uses the fast operator from this many elements on (or when the dense one does
 #: not fit in memory): the measured crossover of the whole paper case (set-up and steps,
-#: BDF2 at dt = 0.01, one BLAS thread): dense / fast 14 / 16 s at 5,766 elements,
-#: 27 / 23 s at 7,998, 56 / 40 s at 11,450 (benchmarks/fast_operator.md, agreement table)
+#: BDF2 at dt = 0.01, one BLAS thread, each path in its own process, in turn): fast / dense
+#: wall time 1.15 at 5,766 elements, 0.90 at 7,998, 0.67 at 11,450 (order-11 operator,
+#: ``benchmarks/fast_operator.py crossover``, medians of 3; ratio 1 near 7,000)
 FAST_CROSSOVER = 8_000
 
 

@@ -325,8 +325,9 @@ def _gb(n: float) -> str:
 #: preconditioner (with its coarse space) and solver, an upper bound of the measured peak
 #: memory per element from 89,000 elements on (benchmarks/fast_operator.md, single-precision
 #: far factors, 3e0e5c7: 26.3-29.4 kB at 89,206, 27.4-27.5 kB at 178,416 and 26.0 kB at
-#: 514,644 half-disk elements, 26.9 kB at 203,152 full-disk textured ones; smaller meshes,
-#: with the interpreter's own ~0.1 GB, are far from any limit)
+#: 514,644 half-disk elements, 26.9 kB at 203,152 full-disk textured ones; the order-11
+#: operator, 42696ab: 30.2, 29.6 and 27.4 kB, textured 27.6 kB; smaller meshes, with the
+#: interpreter's own ~0.1 GB, are far from any limit)
 FAST_BYTES_PER_ELEMENT = 32_000
 
 

@@ -45,7 +45,6 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import SceneError
 from .validation import (
     check_admissibility,
     check_chebyshev_order,
@@ -709,16 +708,8 @@ class FastOptions:
 
     @classmethod
     def of(cls, value) -> FastOptions:
-        """``value`` if it is a FastOptions, else ``FastOptions(tol=value)`` (SceneError
-        naming ``operator_tol`` if it is neither)."""
-        if isinstance(value, cls):
-            return value
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
-            raise SceneError(
-                f"operator_tol must be a number in [1e-12, 0.1) or a femehl.hmatrix.FastOptions, "
-                f"got {value!r}."
-            )
-        return cls(tol=float(value))
+        """``value`` if it is a FastOptions, else ``FastOptions(tol=value)``."""
+        return value if isinstance(value, cls) else cls(tol=value)
 
     @property
     def order(self) -> int:
@@ -756,8 +747,6 @@ class FastCompliance:
             tri = np.concatenate([tri, img])
             src_el = np.concatenate([src_el, src_el])
         self.options = options
-        self.tol = options.tol
-        self.svd_ratio = options.svd_ratio
         cen = disc.centroids
         radius = PRECOND_RADIUS * np.sqrt(np.abs(disc.areas))
 
@@ -800,9 +789,8 @@ class FastCompliance:
             m = min(COARSE_MAX, max(COARSE_MIN, P.shape[1] // COARSE_RATIO))
             self.coarse = self._coarse_space(disc, m)
             self.H.info.update(coarse_nodes=int(self.coarse[0].shape[1]), coarse_s=time.perf_counter() - t1)
-        self.info = dict(
-            self.H.info, operator_tol=self.tol, svd_ratio=self.svd_ratio, build_s=time.perf_counter() - t0
-        )
+        build_s = time.perf_counter() - t0
+        self.info = dict(self.H.info, operator_tol=options.tol, svd_ratio=options.svd_ratio, build_s=build_s)
 
     def _coarse_space(self, disc, m: int) -> tuple:
         """``(P, C P)`` of about ``m`` coarse nodes, ``C P`` by blocked products (set-up)."""

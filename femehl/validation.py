@@ -23,6 +23,7 @@ from .errors import SceneError
 __all__ = [
     "call_time_function",
     "check_finite",
+    "check_in_range",
     "check_int",
     "check_nonnegative",
     "check_positive",
@@ -146,29 +147,34 @@ def call_time_function(history: str, symbol: str, f, t: float, hint: str = "") -
     return check_finite(f"{symbol}(t={t:g})", v, hint)
 
 
+def check_in_range(name: str, value, low: float, high: float, *, open_low=False, open_high=False) -> float:
+    """``value`` as a float if it is a finite real number (:func:`check_finite`) in the
+    interval from ``low`` to ``high`` (ends open as told), else SceneError naming it."""
+    interval = f"{'(' if open_low else '['}{low:g}, {high:g}{')' if open_high else ']'}"
+    v = check_finite(name, value, f"It is a number in {interval}.")
+    if not ((low < v if open_low else low <= v) and (v < high if open_high else v <= high)):
+        raise SceneError(f"{name} must be a number in {interval}, got {value!r}.")
+    return v
+
+
 def check_operator_tol(value) -> float:
     """The fast elastic operator's relative error: a number in [1e-12, 0.1)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (1e-12 <= value < 0.1):
-        raise SceneError(f"operator_tol must be a number in [1e-12, 0.1), got {value!r}.")
-    return float(value)
+    return check_in_range("operator_tol", value, 1e-12, 0.1, open_high=True)
 
 
 def check_chebyshev_order(value) -> int:
     """Chebyshev points per axis of the fast operator (an experiment's override): 2..16."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 2 <= value <= 16:
+    p = check_int("the Chebyshev order p", value, 2, "It is in [2, 16].")
+    if p > 16:
         raise SceneError(f"the Chebyshev order p must be an integer in [2, 16], got {value!r}.")
-    return int(value)
+    return p
 
 
 def check_svd_ratio(value) -> float:
-    """Truncation of the fast operator's couplings, relative to operator_tol: in (0, 1e3]."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < value <= 1e3):
-        raise SceneError(f"svd_ratio must be a number in (0, 1000], got {value!r}.")
-    return float(value)
+    """Truncation of the fast operator's couplings, relative to operator_tol: in (0, 1000]."""
+    return check_in_range("svd_ratio", value, 0.0, 1e3, open_low=True)
 
 
 def check_admissibility(value) -> float:
     """Admissibility of the fast operator's far blocks (an experiment's override): in [0.5, 10]."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.5 <= value <= 10.0):
-        raise SceneError(f"the admissibility eta must be a number in [0.5, 10], got {value!r}.")
-    return float(value)
+    return check_in_range("the admissibility eta", value, 0.5, 10.0)

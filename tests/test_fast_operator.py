@@ -113,9 +113,8 @@ def test_truncation_and_order_overrides(sphere):
     assert wide.info["eta"] == 4.0 and wide.info["near_nnz"] < fine.info["near_nnz"]
     stepped = FastCompliance(disc, FastOptions(rank_step=8), coarse=False)
     assert stepped.info["rank_step"] == 8 and stepped.H.nbytes > FastCompliance(disc, coarse=False).H.nbytes
-    mesh = fitted_disk(sphere, 5.0, 1.0)
-    via_solve = FEDisc(sphere, mesh=mesh, operator="fast", operator_tol=FastOptions(p=7))
-    assert via_solve.boussinesq().H.p == 7 and via_solve.operator_tol == 1e-6
+    via_solve = FEDisc(sphere, mesh=disc.dm, operator="fast", operator_tol=FastOptions(p=7))
+    assert via_solve.boussinesq().H.p == 7 and via_solve.fast_options.tol == 1e-6
     bad = ({"p": 1}, {"p": 9.5}, {"p": True}, {"svd_ratio": 0.0}, {"svd_ratio": float("nan")}, {"eta": 0.1})
     for kwargs in bad + ({"eta": "2"}, {"rank_step": 0}, {"tol": 1.0}):
         with pytest.raises(SceneError, match="p must|svd_ratio must|eta must|rank_step must|operator_tol"):

@@ -66,7 +66,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SceneError, SingularSystemError
-from ..validation import check_positive
+from ..validation import check_in_range
 
 __all__ = [
     "StepOperator",
@@ -653,9 +653,7 @@ class RecycledGCR:
         max_krylov: int | None = None,
     ):
         if rtol is not None:
-            rtol = check_positive("rtol", rtol, "The Krylov tolerance is a number in (0, 1e-2), or None.")
-            if rtol >= 1e-2:
-                raise SceneError(f"rtol must be in (0, 1e-2), got {rtol!r}.")
+            rtol = check_in_range("rtol", rtol, 0.0, 1e-2, open_low=True, open_high=True)
         if refactor_after is not None and (
             isinstance(refactor_after, bool) or not isinstance(refactor_after, int) or refactor_after < 1
         ):

@@ -148,7 +148,6 @@ class FEDisc(P1P0):
         self._finder_ = None
         self.operator = self._resolve_operator(operator, ne)
         self.fast_options = fast_options
-        self.operator_tol = fast_options.tol
         self.info = {
             "mesh": dm.name,
             "half": dm.half,

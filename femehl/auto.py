@@ -8,7 +8,8 @@ What ``tol`` means
 The load, the central film and the minimum film (the true minimum over film points,
 origin and nodes, :mod:`femehl.core.stepper`) at every step of the returned run are
 within ``tol`` relative (the load relative to ``max(|load|, 0.1)``: a load growing from 0
-has no relative error at t = 0), as estimated below.  The fields are not estimated
+has no relative error at t = 0): the estimate below is at most ``ACCEPT * tol`` = 0.75
+tol, a margin for the estimate running up to a third below the true error.  The fields are not estimated
 separately: the film and pressure errors in the max norm over the film points are what
 the time controller bounds per step, and the mesh is the one whose headline errors pass.
 
@@ -29,7 +30,8 @@ The sequence
 Levels 4, 2 (pilots: cheap, their fields never written), then each next level aims at
 an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
 ``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
-accepted when it is at least the third and its estimate is <= tol.  A level whose cells
+accepted when it is at least the third and its estimate is <= ``ACCEPT * tol`` = 0.75
+tol (:data:`ACCEPT`: the margin for the estimate's measured shortfall).  A level whose cells
 would exceed ``max_elements`` (:func:`cell_budget`: 100,000 on a substrate with the fast
 hierarchical operator or with sparse operators only, a cost budget a caller may raise;
 25,000 on one whose operator is dense only, a layer, where the dense influence matrix
@@ -94,6 +96,7 @@ __all__ = [
     "LADDERS",
     "register_ladder",
     "QUANTITIES",
+    "ACCEPT",
     "MAX_ELEMENTS",
     "LOCAL_MAX_ELEMENTS",
     "FAST_MAX_ELEMENTS",
@@ -133,6 +136,15 @@ LEVEL0 = 4.0
 MIN_RUNS = 3
 #: the next level aims at an estimated error of SAFETY * tol ...
 SAFETY = 0.6
+#: a run is accepted (``reached``) when its estimate is <= ACCEPT * tol.  The estimate
+#: assumes order 2; on the fitted meshes the films converge somewhat slower between the
+#: levels that decide (observed orders 1.4-2), so it runs low: over every pair of the
+#: thirteen tol = 1e-2 scenes of ``benchmarks/auto.py`` at levels <= 1 whose true error is
+#: above its reference's uncertainty, true / estimated was at most 1.31 (the central film
+#: of the punch), 1.23 at an estimate near tol (the minimum film, sphere at beta = 2000),
+#: where accepting at the estimate <= tol left two scenes 4-14 % over tol.  1 / 0.75 = 1.33
+#: covers the largest (``benchmarks/auto_results.md``, "Acceptance margin").
+ACCEPT = 0.75
 #: ... with a ratio to the previous level in this range
 RATIO_RANGE = (math.sqrt(2.0), 2.0)
 #: the level the estimate asks for would exceed the cell budget: the finest level within
@@ -553,8 +565,9 @@ def solve_to_tolerance(
 
     Returns the finest run (a :class:`~femehl.result.Result`) with ``result.estimate``
     (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
-    ``reached``, ``stopped`` (None, ``"cell budget"`` or ``"time budget"``: what ended
-    a sequence that did not reach ``tol``), ``levels``, ``elements``, ``steps``,
+    ``reached`` (the estimate is <= :data:`ACCEPT` * ``tol``), ``accept``, ``stopped``
+    (None, ``"cell budget"`` or ``"time budget"``: what ended a sequence that did not
+    reach ``tol``), ``levels``, ``elements``, ``steps``,
     ``rejected_steps``, ``tol_t`` and ``wall`` of every run, and the largest estimated
     ``total``, ``space`` and ``time`` errors.  ``level`` is the first (coarsest) level;
     ``max_elements`` the cell budget (default: :func:`cell_budget` of the scene's
@@ -667,7 +680,7 @@ def solve_to_tolerance(
             fine._stored.clear()  # superseded: its scalars stay (the companion), its fields go
         fine = res
         runs.append(res)
-        if len(runs) >= MIN_RUNS and err <= tol:
+        if len(runs) >= MIN_RUNS and err <= ACCEPT * tol:
             reached = True
             break
         if last:
@@ -720,6 +733,7 @@ def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -
     info = {
         "tol": tol,
         "reached": reached,
+        "accept": ACCEPT,
         "stopped": stopped,
         "max_wall": max_wall,
         "levels": [r.info["level"] for r in runs],
@@ -737,6 +751,11 @@ def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -
         cells = max(info["elements"])
         within = f"max_wall = {max_wall:g} s" if stopped == "time budget" else f"{cells} cells"
         logger.warning(
-            "solve_to_tolerance: tolerance %g not reached within %s: estimated error %s", tol, within, worst
+            "solve_to_tolerance: tolerance %g not reached within %s: estimated error %s (accepted at "
+            "<= %g tol)",
+            tol,
+            within,
+            worst,
+            ACCEPT,
         )
     return res

@@ -172,6 +172,29 @@ def test_sphere_is_honest():
     check_honest(errs, tol, bound=tol, share=0.9)
 
 
+def test_an_estimate_near_tol_is_not_accepted(monkeypatch):
+    """A run is accepted at an estimate <= ACCEPT * tol, not <= tol (the margin for the
+    estimate's measured shortfall, femehl.auto.ACCEPT): with the third run's estimate at
+    0.9 tol a fourth, finer run is made, and its 0.7 tol is the answer."""
+    import femehl.auto as auto
+
+    real, tol = auto.estimate, 1e-2
+    worst = iter([5 * tol, 0.9 * tol, 0.7 * tol])  # the pairs ending at the 2nd, 3rd and 4th run
+
+    def scaled(fine, coarse, ratio):
+        est = real(fine, coarse, ratio)
+        k = next(worst) / auto._worst(est)
+        return {"t": est["t"], **{q: {p: v * k for p, v in est[q].items()} for q in QUANTITIES}}
+
+    monkeypatch.setattr(auto, "estimate", scaled)
+    res = femehl.solve(LineScene(), t_end=0.5, tol=tol, store_every=0)
+    a = res.info["auto"]
+    assert len(a["levels"]) == 4 and a["reached"] and a["accept"] == 0.75
+    assert a["total"] == pytest.approx(0.7 * tol)
+    # the level after 0.9 tol aims at SAFETY * tol: the smallest ratio, sqrt(2)
+    assert a["levels"][2] / a["levels"][3] == pytest.approx(np.sqrt(2.0))
+
+
 def test_budget_stops_with_a_warning(caplog):
     """A budget below the second level: one run, no estimate, reached False, a warning."""
     scene = femehl.presets.paper_sphere()

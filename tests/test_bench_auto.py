@@ -105,3 +105,36 @@ def test_redo_reruns_only_the_tolerances_asked_for(bench, tmp_path, monkeypatch)
     kept = map(json.loads, runs.read_text().splitlines())
     marks = sorted((r["kind"], r.get("tol"), r["mark"]) for r in kept)
     assert marks == [("auto", 0.001, "new"), ("auto", 0.01, "kept"), ("hand", None, "kept")]
+
+
+@pytest.fixture(scope="module")
+def margin():
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    path = ROOT / "benchmarks" / "auto_margin.py"
+    spec = importlib.util.spec_from_file_location("femehl_bench_margin", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _pair(level, est, true, unc, kind="sequence"):
+    p = {"level": level, "elements": 100, "kind": kind}
+    for q, e, t, u in zip(("load", "film_center", "film_min"), est, true, unc, strict=True):
+        p[q] = {"estimate": e, "true": t, "reference": u}
+    return p
+
+
+def test_the_margin_is_worst_true_over_worst_estimate(margin):
+    """The acceptance bounds the worst estimate of the three quantities, so the ratio is the
+    worst true error over the worst estimate, not a per-quantity one: here the central film's
+    true error (0.6 %) is 3 times its estimate but under the minimum film's estimate."""
+    tol = 1e-2
+    p = _pair(1.0, (1e-4, 2e-3, 8e-3), (1e-4, 6e-3, 5e-3), (0.0, 1e-3, 1e-3))
+    ratio, judged = margin._worst_ratio(p, tol)
+    assert ratio == pytest.approx(6e-3 / 8e-3) and judged
+    # a pilot (level 2) is never judged; nor a true error under twice the reference's uncertainty
+    assert not margin._worst_ratio(_pair(2.0, (1e-4, 2e-3, 8e-3), (1e-4, 6e-3, 5e-3), (0, 0, 0)), tol)[1]
+    ratio, judged = margin._worst_ratio(_pair(0.7, (0, 0, 4e-3), (0, 0, 5e-3), (0, 0, 3e-3)), tol)
+    assert ratio == pytest.approx(1.25) and not judged
+    text = margin.report([{"scene": "s", "tol": tol, "accept": 0.75, "pairs": [p]}])
+    assert "| 0.75 |" in text and "Judged: 1 pairs. Worst true / worst estimate at most 0.75" in text

@@ -71,7 +71,14 @@ def worker(spec: dict) -> dict:
     out = dict(spec, status="ok")
     try:
         if spec["kind"] == "auto":
-            res = femehl.solve(scene, t_end=t_end, tol=spec["tol"], store_every=0, max_elements=MAX_CELLS)
+            res = femehl.solve(
+                scene,
+                t_end=t_end,
+                tol=spec["tol"],
+                store_every=0,
+                max_elements=MAX_CELLS,
+                max_wall=spec.get("max_wall"),
+            )
         else:
             mesh = spec["mesh"] if "mesh" in spec else fitted_disk(scene, t_end, level=spec["level"])
             res = femehl.solve(
@@ -234,7 +241,13 @@ def _pct(x) -> str:
 def _status(r: dict) -> str:
     if r.get("status") != "ok":
         return r.get("status", "?")[:80]
-    return "reached" if r.get("auto", {}).get("reached") else "not reached (budget)"
+    a = r.get("auto", {})
+    if a.get("reached"):
+        return "reached"
+    budget = a.get("stopped") or "budget"
+    if budget == "time budget" and r.get("max_wall"):
+        budget = f"time budget, max_wall {r['max_wall']:g} s"
+    return f"not reached ({budget})"
 
 
 def cheapest(hand: list, r: dict, ref, limit: float) -> str:
@@ -395,6 +408,11 @@ def main(argv=None) -> None:
     ap.add_argument("--resume", action="store_true", help="skip runs already in auto_runs.jsonl")
     ap.add_argument("--analyze-only", action="store_true")
     ap.add_argument("--cap", type=float, default=1200.0, help="wall-time cap per run, seconds")
+    ap.add_argument(
+        "--max-wall",
+        type=float,
+        help="femehl's own time budget of the automatic runs (max_wall), seconds; give a --cap above it",
+    )
     ap.add_argument("--redo", help="comma-separated scene names whose automatic runs at --tol are run again")
     args = ap.parse_args(argv)
     if args.worker:
@@ -407,6 +425,8 @@ def main(argv=None) -> None:
     records = [json.loads(s) for s in RUNS.read_text().splitlines()] if RUNS.is_file() else []
     if not args.analyze_only:
         specs = [dict(kind="auto", scene=n, tol=float(t)) for t in args.tol.split(",") for n in names]
+        if args.max_wall is not None:
+            specs = [dict(s, max_wall=args.max_wall) for s in specs]
         if not args.no_hand:
             specs += [
                 dict(kind="hand", scene=n, level=lv, dt=dt)

@@ -272,7 +272,8 @@ def _automatic(
                 for lv, n, k in zip(a["levels"], a["elements"], a["steps"], strict=True)
             )
             + f"; estimated error {a.get('total', float('nan')):.2g} "
-            + ("(tol reached)" if a["reached"] else "(tol NOT reached)")
+            + ("(tol reached" if a["reached"] else "(tol NOT reached")
+            + f": accepted at <= {a.get('accept', 1.0):g} tol)"
         )
     return res
 

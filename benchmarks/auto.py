@@ -298,6 +298,67 @@ def compact(records: list, refs: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def targets(records: list, refs: dict) -> list:
+    """The issue's accuracy targets, counted over the automatic runs (lines of markdown).
+
+    * true error <= tol (tol = 1e-2) and <= 2 tol (tol = 1e-3), worst of the three
+      quantities, over the runs whose check is independent (:func:`independent`) and whose
+      reference is certain enough to decide: the true error plus the reference's
+      uncertainty below the bound (met), the true error minus it above (missed), else
+      undecided;
+    * the estimate (max over the steps) at least half the true error (max over the steps),
+      per (scene, tol, quantity) whose true error is above its reference's uncertainty and
+      above tol / 100.
+    """
+    bound = {1e-2: 1.0, 1e-3: 2.0}
+    met, missed, undecided, dependent = [], [], [], []
+    halves, short = 0, []
+    for r in [r for r in records if r["kind"] == "auto" and r.get("status") == "ok" and "t" in r]:
+        ref = _ref(refs, r["scene"])
+        if not ref:
+            continue
+        errs = true_errors(r, ref)
+        name = f"{r['scene']} ({r['tol']:g})"
+        limit = bound.get(r["tol"], 1.0) * r["tol"]
+        unc = {k: float(ref["uncertainty"].get(k, 0.0)) for k in QUANTITIES}
+        q = max(QUANTITIES, key=lambda k: errs[k]["true"] + unc[k])  # the least certain to be met
+        true = errs[q]["true"]
+        if not independent(r, ref):
+            dependent.append(name)
+        elif all(errs[k]["true"] + unc[k] <= limit for k in QUANTITIES):
+            met.append(name)
+        elif any(errs[k]["true"] - unc[k] > limit for k in QUANTITIES):
+            missed.append(f"{name}: {_pct(true)}")
+        else:
+            undecided.append(f"{name}: {q} {_pct(true)} +- {_pct(unc[q])}")
+        for k in QUANTITIES:
+            e = errs[k]
+            if e["true"] > max(float(ref["uncertainty"].get(k, 0.0)), r["tol"] / 100):
+                if e.get("estimate", 0.0) >= 0.5 * e["true"]:
+                    halves += 1
+                else:
+                    short.append(f"{name} {k}: {_pct(e.get('estimate'))} / {_pct(e['true'])}")
+    judged = halves + len(short)
+    out = [
+        "True error within tol (tol = 1e-2) or 2 tol (tol = 1e-3), worst of the three quantities, "
+        "decided when the true error plus or minus the reference's uncertainty is on one side "
+        "of the bound:",
+        "",
+        f"- met: {len(met)} ({', '.join(met) or '-'})",
+        f"- missed: {len(missed)} ({', '.join(missed) or '-'})",
+        f"- undecided (the reference as uncertain as the margin): {len(undecided)} "
+        f"({', '.join(undecided) or '-'})",
+        f"- not an independent check (the last run on about the reference's finest mesh): "
+        f"{len(dependent)} ({', '.join(dependent) or '-'})",
+        "",
+        f"Estimate (max over the steps) >= half the true error (max), over the {judged} entries "
+        "(scene, tol, quantity) whose true error is above its reference's uncertainty and tol / 100: "
+        + (f"{halves} ({halves / judged:.0%})" if judged else "-")
+        + (f"; short: {'; '.join(short)}" if short else ""),
+    ]
+    return out
+
+
 def analyze(records: list, refs: dict) -> str:
     """The markdown tables; also writes the plot."""
     scenes = _scenes()
@@ -352,6 +413,7 @@ def analyze(records: list, refs: dict) -> str:
             + ", ".join(f"{q} {_pct(unc.get(q))}" for q in QUANTITIES)
             + " |"
         )
+    lines += ["", "## Against the targets", "", *targets(records, refs)]
     # item 5: the reported minimum is the true minimum (origin and nodes included)
     import numpy as np
 

@@ -202,24 +202,20 @@ def report(records: list) -> str:
             cells.append(", ".join(_pct(p[q]["reference"]) for q in QUANTITIES))
             lines.append("| " + " | ".join(cells) + " |")
     lines.append("")
-    if judged:
-        judged.sort(reverse=True)
-        w = judged[0]
-        lines.append(
-            f"Judged: {len(judged)} pairs. Worst true / worst estimate at most {w[0]:.2f} "
-            f"({w[1]}, level {w[2]:.3g}, estimate {w[3]:.2g} tol); above 1 in "
-            f"{sum(r[0] > 1 for r in judged)}."
-        )
-    if unsure:
-        unsure.sort(reverse=True)
-        u = unsure[0]
-        lines.append(
-            f"Not judged (the reference as uncertain as the error): {len(unsure)} pairs, at most "
-            f"{u[0]:.2f} ({u[1]}, level {u[2]:.3g})."
-        )
+    unsure_label = "Not judged (the reference as uncertain as the error)"
+    for label, entries in (("Judged", judged), (unsure_label, unsure)):
+        if entries:
+            w = max(entries)
+            lines.append(
+                f"{label}: {len(entries)} pairs; worst true / worst estimate at most {w[0]:.2f} "
+                f"({w[1]}, level {w[2]:.3g}, estimate {w[3]:.2g} tol), above 1 in "
+                f"{sum(r[0] > 1 for r in entries)}."
+            )
+    from femehl.auto import ACCEPT
+
     lines.append(
         "A run accepted at a worst estimate <= ACCEPT * tol is within tol while worst true / "
-        f"worst estimate <= 1 / ACCEPT: ACCEPT = 0.75 covers {1 / 0.75:.2f}."
+        f"worst estimate <= 1 / ACCEPT: ACCEPT = {ACCEPT:g} covers {1 / ACCEPT:.2f}."
     )
     lines.append("")
     lines.append("## When the runs were made")

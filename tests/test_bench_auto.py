@@ -137,4 +137,4 @@ def test_the_margin_is_worst_true_over_worst_estimate(margin):
     ratio, judged = margin._worst_ratio(_pair(0.7, (0, 0, 4e-3), (0, 0, 5e-3), (0, 0, 3e-3)), tol)
     assert ratio == pytest.approx(1.25) and not judged
     text = margin.report([{"scene": "s", "tol": tol, "accept": 0.75, "pairs": [p]}])
-    assert "| 0.75 |" in text and "Judged: 1 pairs. Worst true / worst estimate at most 0.75" in text
+    assert "| 0.75 |" in text and "Judged: 1 pairs; worst true / worst estimate at most 0.75" in text

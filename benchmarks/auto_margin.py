@@ -52,41 +52,39 @@ def capture(name: str, tol: float) -> dict:
     import femehl.auto as auto
 
     factory, t_end = SCENES[name]
-    runs, real = [], auto._run
+    runs = []
+    t0 = time.perf_counter()
+    femehl.solve(factory(), t_end=t_end, tol=tol, store_every=0, on_run=runs.append)
+    wall = time.perf_counter() - t0
 
-    def keep(*args, **kwargs):
-        res = real(*args, **kwargs)
-        runs.append(res)
-        return res
-
-    auto._run = keep
-    try:
-        t0 = time.perf_counter()
-        femehl.solve(factory(), t_end=t_end, tol=tol, store_every=0)
-        wall = time.perf_counter() - t0
-    finally:
-        auto._run = real
-    scene = factory()
-    method = scene.default_method
-    extra = real(scene, method, auto.LADDERS[method], t_end, runs[-1].info["level"] / math.sqrt(2), 0, {})
-
-    def series(r, kind):
+    def series(r, kind, level, seconds):
         return {
             "kind": kind,
-            "level": r.info["level"],
-            "elements": r.info["elements"],
-            "wall": r.info["wall"],
+            "level": level,
+            "elements": r.info.get("elements"),
+            "wall": seconds,
             "steps": r.nsteps,
             "t": r.t.tolist(),
             **{q: getattr(r, q).tolist() for q in QUANTITIES},
         }
 
+    # one level sqrt(2) finer, run as the sequence runs a level: its ladder's discretization
+    # and adaptive steps at that level's time tolerance
+    scene = factory()
+    level = runs[-1].info["level"] / math.sqrt(2)
+    options = auto.LADDERS[scene.default_method].options(scene, t_end, level)
+    t1 = time.perf_counter()
+    extra = femehl.solve(
+        scene, t_end=t_end, tol=auto.time_tolerance(level), store_every=0, estimate=False, **options
+    )
+    extra = series(extra, "extra", level, time.perf_counter() - t1)
+    sequence = [series(r, "sequence", r.info["level"], r.info["wall"]) for r in runs]
     return {
         "scene": name,
         "tol": tol,
         "wall_s": wall,
         "accept": auto.ACCEPT,
-        "runs": [series(r, "sequence") for r in runs] + [series(extra, "extra")],
+        "runs": [*sequence, extra],
     }
 
 

@@ -95,7 +95,7 @@ def is_automatic(scene, method: str | None, dt, options) -> bool:
 
 
 #: options of the automatic mode only (:func:`femehl.auto.solve_to_tolerance`)
-AUTO_ONLY = ("max_elements", "max_wall", "level")
+AUTO_ONLY = ("max_elements", "max_wall", "level", "on_run")
 
 
 def refuse_auto_only(options) -> None:
@@ -131,7 +131,7 @@ def solve(
       minimum film are within ``tol`` (default 1e-2) at every step
       (:func:`femehl.auto.solve_to_tolerance`); the result carries the error estimate,
       ``result.uncertainty(name, t)``; ``max_wall=`` (seconds) and ``max_elements=``
-      (cells) bound what it may spend;
+      (cells) bound what it may spend, ``on_run=`` sees every finished run (pilots too);
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
       discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
       ``tol`` is given.  The result carries the space part of the error estimate from a

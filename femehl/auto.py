@@ -9,9 +9,10 @@ The load, the central film and the minimum film (the true minimum over film poin
 origin and nodes, :mod:`femehl.core.stepper`) at every step of the returned run are
 within ``tol`` relative (the load relative to ``max(|load|, 0.1)``: a load growing from 0
 has no relative error at t = 0): the estimate below is at most ``ACCEPT * tol`` = 0.75
-tol, a margin for the estimate running up to a quarter below the true error.  The fields are not estimated
-separately: the film and pressure errors in the max norm over the film points are what
-the time controller bounds per step, and the mesh is the one whose headline errors pass.
+tol, a margin for the estimate running up to a quarter below the true error.  The fields
+are not estimated separately: the film and pressure errors in the max norm over the film
+points are what the time controller bounds per step, and the mesh is the one whose
+headline errors pass.
 
 One number refines everything: the level
 ----------------------------------------
@@ -143,7 +144,7 @@ SAFETY = 0.6
 #: worst true error is at least twice its reference's uncertainty, worst true / worst
 #: estimate was at most 1.23 (22 pairs, above 1 in 11), 1.29 where the reference is as
 #: uncertain as the error; accepted at <= tol, the sphere sliding at beta = 2000 and the
-#: ellipsoid along the sliding ended 14 % and 5 % over tol.  1 / 0.75 = 1.33 covers both.
+#: ellipsoid along the sliding ended 14 % and 5 % over tol.  1 / 0.75 = 1.33 covers both ratios.
 ACCEPT = 0.75
 #: ... with a ratio to the previous level in this range
 RATIO_RANGE = (math.sqrt(2.0), 2.0)
@@ -559,6 +560,7 @@ def solve_to_tolerance(
     max_wall: float | None = None,
     level: float = LEVEL0,
     runner=None,
+    on_run: Callable[[Result], None] | None = None,
     **options,
 ) -> Result:
     """Run ``scene`` to ``t_end`` with the load and films to about ``tol`` relative.
@@ -574,7 +576,9 @@ def solve_to_tolerance(
     substrate); ``max_wall`` a time budget in seconds for the whole sequence (default:
     none; see the module docstring); ``options`` go to
     :func:`femehl.solve` (not the discretization's,
-    nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run.
+    nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run;
+    ``on_run(result)`` with every finished run, pilots included (its scalars stay; its
+    fields are dropped once a finer run supersedes it).
     """
     from .api import _registry
 
@@ -588,6 +592,8 @@ def solve_to_tolerance(
         )
     if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
         raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
+    if on_run is not None and not callable(on_run):
+        raise SceneError(f"on_run must be a function of a finished run (a Result), got {on_run!r}.")
     ladder = LADDERS[method]
     max_elements = cell_budget(scene, max_elements)
     max_wall = check_max_wall(max_wall)
@@ -680,6 +686,8 @@ def solve_to_tolerance(
             fine._stored.clear()  # superseded: its scalars stay (the companion), its fields go
         fine = res
         runs.append(res)
+        if on_run is not None:
+            on_run(res)
         if len(runs) >= MIN_RUNS and err <= ACCEPT * tol:
             reached = True
             break

@@ -187,9 +187,12 @@ def test_an_estimate_near_tol_is_not_accepted(monkeypatch):
         return {"t": est["t"], **{q: {p: v * k for p, v in est[q].items()} for q in QUANTITIES}}
 
     monkeypatch.setattr(auto, "estimate", scaled)
-    res = femehl.solve(LineScene(), t_end=0.5, tol=tol, store_every=0)
+    seen = []
+    res = femehl.solve(LineScene(), t_end=0.5, tol=tol, store_every=0, on_run=seen.append)
     a = res.info["auto"]
     assert len(a["levels"]) == 4 and a["reached"] and a["accept"] == 0.75
+    # on_run saw every finished run, pilots included, the answer last
+    assert [r.info["level"] for r in seen] == a["levels"] and seen[-1] is res
     assert a["total"] == pytest.approx(0.7 * tol)
     # the level after 0.9 tol aims at SAFETY * tol: the smallest ratio, sqrt(2)
     assert a["levels"][2] / a["levels"][3] == pytest.approx(np.sqrt(2.0))
@@ -363,6 +366,15 @@ def test_max_wall_is_checked():
             femehl.solve(scene, t_end=0.1, max_wall=bad)
     with pytest.raises(femehl.SceneError, match="automatic mode only"):
         femehl.solve(scene, t_end=0.02, dt=0.01, mesh="coarse", max_wall=60)
+
+
+def test_on_run_is_checked():
+    """``on_run`` is a function, and of the automatic mode only."""
+    scene = femehl.presets.paper_sphere()
+    with pytest.raises(femehl.SceneError, match="on_run must be a function"):
+        femehl.solve(scene, t_end=0.02, on_run="print")
+    with pytest.raises(femehl.SceneError, match="automatic mode only"):
+        femehl.solve(scene, t_end=0.02, dt=0.01, mesh="coarse", on_run=print)
 
 
 def test_no_run_in_time_is_a_time_budget_error():

@@ -379,6 +379,80 @@ def targets(records: list, refs: dict) -> list:
     return out
 
 
+def pair_estimate(a: dict, b: dict, t_from: float) -> float:
+    """The automatic mode's estimate of the finer fixed-step run ``b`` from the coarser ``a``
+    (same steps): worst over the quantities of ``max_t |q_b - q_a| / (r^2 - 1) / scale``,
+    ``r`` the level ratio, over the times ``t >= t_from`` (the compared window)."""
+    import numpy as np
+
+    t = np.asarray(b["t"])
+    keep = t >= t_from - 1e-9
+    worst = 0.0
+    for q in QUANTITIES:
+        qa, qb = np.asarray(a[q])[keep], np.asarray(b[q])[keep]
+        scale = np.maximum(np.abs(qb), 0.1 if q == "load" else 0.0)
+        r = a["level"] / b["level"]
+        worst = max(worst, float(np.max(np.abs(qb - qa) / scale)) / (r**2 - 1.0))
+    return worst
+
+
+def cost_target(records: list, refs: dict, scene: str = "paper", tol: float = 1e-2) -> list:
+    """The cost target (the automatic run at most 1.5 x the cheapest hand-tuned setting within
+    tol) and what any sequence that certifies its answer costs on the hand grid (lines).
+
+    A certified answer needs its estimate: from a second run, coarser, in the automatic
+    mode.  The cheapest such pair on the hand grid: two runs of the same step ``dt`` (the
+    estimate sees the space error only; the time error is then the same in both), the finer
+    one's pair estimate (:func:`pair_estimate`) at most ``femehl.auto.ACCEPT * tol`` and at
+    least its worst true error (an estimate that does not bound the error certifies
+    nothing).  The grid is coarse (levels 1.41, 1, 0.71, 0.5), so this is the grid's figure,
+    not a bound over every level."""
+    from femehl.auto import ACCEPT
+
+    ref = _ref(refs, scene)
+    hand = [h for h in records if h["kind"] == "hand" and h["scene"] == scene and h.get("status") == "ok"]
+    auto = [r for r in records if r["kind"] == "auto" and r["scene"] == scene and r.get("tol") == tol]
+    if not ref or not hand or not auto or auto[-1].get("status") != "ok":
+        return []
+    r = auto[-1]
+    true = {id(h): max(e["true"] for e in true_errors(h, ref).values()) for h in hand}
+    within = [h for h in hand if true[id(h)] <= tol]
+    if not within:
+        return []
+    best = min(within, key=lambda h: h["wall_s"])
+    leveled = [h for h in hand if "level" in h]
+    pairs = []
+    for a in leveled:
+        for b in leveled:
+            if a["dt"] == b["dt"] and a["level"] > b["level"]:
+                est = pair_estimate(a, b, ref["t_from"])
+                if true[id(b)] <= est <= ACCEPT * tol:
+                    pairs.append((a["wall_s"] + b["wall_s"], a, b, est))
+    a_runs = r.get("auto", {})
+    out = [
+        "",
+        f"Cost ({scene}, tol = {tol:g}; target: at most 1.5 x the cheapest hand-tuned setting within "
+        f"tol): the automatic run {r['wall_s']:.1f} s over {len(a_runs.get('levels', []))} runs "
+        f"(the last {a_runs.get('wall', [0])[-1]:.1f} s, {a_runs.get('steps', [0])[-1]} steps), "
+        f"the cheapest hand setting within tol level {best.get('level', best.get('mesh'))}, "
+        f"dt {best['dt']:g}: {best['wall_s']:.1f} s, true error {_pct(true[id(best)])}: "
+        f"{r['wall_s'] / best['wall_s']:.2f} x.",
+    ]
+    if pairs:
+        cost, a, b, est = min(pairs, key=lambda p: p[0])
+        out[-1] += (
+            f"  Certifying costs a second run: the cheapest pair of hand runs whose estimate is "
+            f"<= {ACCEPT:g} tol and bounds the finer run's true error is levels {a['level']:g} and "
+            f"{b['level']:g} at dt {b['dt']:g} (estimate {_pct(est)}, true {_pct(true[id(b)])}), "
+            f"{cost:.1f} s = {cost / best['wall_s']:.2f} x, the finer run alone "
+            f"{b['wall_s'] / best['wall_s']:.2f} x: no pair on the grid certifies tol within 1.5 x."
+            if cost > 1.5 * best["wall_s"]
+            else f"  The cheapest certifying pair on the grid: levels {a['level']:g} and {b['level']:g} "
+            f"at dt {b['dt']:g}, {cost:.1f} s = {cost / best['wall_s']:.2f} x."
+        )
+    return out
+
+
 def analyze(records: list, refs: dict) -> str:
     """The markdown tables; also writes the plot."""
     scenes = _scenes()
@@ -433,7 +507,7 @@ def analyze(records: list, refs: dict) -> str:
             + ", ".join(f"{q} {_pct(unc.get(q))}" for q in QUANTITIES)
             + " |"
         )
-    lines += ["", "## Against the targets", "", *targets(records, refs)]
+    lines += ["", "## Against the targets", "", *targets(records, refs), *cost_target(records, refs)]
     # item 5: the reported minimum is the true minimum (origin and nodes included)
     import numpy as np
 

@@ -138,3 +138,61 @@ def test_the_margin_is_worst_true_over_worst_estimate(margin):
     assert ratio == pytest.approx(1.25) and not judged
     text = margin.report([{"scene": "s", "tol": tol, "accept": 0.75, "pairs": [p]}])
     assert "| 0.75 |" in text and "Judged: 1 pairs; worst true / worst estimate at most 0.75" in text
+
+
+def test_a_refined_reference_replaces_its_window_only():
+    """Manufactured series q(t, h, dt) = f(t) + C h^2 + D dt^2 (the error model the reference
+    assumes): over the refinement's window the reference is f + D (dt/2)^2 exactly, its time
+    error the D (dt/2)^2 it carries, its correction C h_b^2 / f; beyond it the scene's own."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import auto_reference_scenes as ars
+
+    f = lambda t: 0.4 + 0.1 * np.sin(3 * t)  # noqa: E731
+    C, D, dt = 0.05, 40.0, 0.005
+
+    def run(level, step, t_end):
+        t = np.round(np.arange(0.0, t_end + 1e-9, step), 12)
+        v = (f(t) + C * level**2 + D * step**2).tolist()
+        return {"level": level, "dt": step, "t": t.tolist(), **{q: v for q in ars.QUANTITIES}}
+
+    entry = {
+        "runs": {"a": run(0.25, dt, 2.0), "b": run(0.18, dt, 2.0), "a_dt2": run(0.25, 2 * dt, 2.0)},
+        "refined": {
+            "t_end": 1.0,
+            "dt": dt / 2,
+            "a": run(0.25, dt / 2, 1.0),
+            "b": run(0.18, dt / 2, 1.0),
+            "a_dt": run(0.25, dt, 1.0),
+        },
+    }
+    tu, u, te, e, qx = ars._series_errors(entry, "film_min")
+    t = np.asarray(entry["runs"]["b"]["t"])
+    inside = t <= 1.0 + 1e-9
+    np.testing.assert_allclose(qx[inside], f(t[inside]) + D * (dt / 2) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(qx[~inside], f(t[~inside]) + D * dt**2, rtol=1e-12)
+    # the time errors: of the dt / 2 runs inside, of the dt runs after
+    e_in, e_out = e[te <= 1.0 + 1e-9], e[te > 1.0 + 1e-9]
+    qa = lambda tt: f(tt) + C * 0.25**2 + D * dt**2  # noqa: E731  (relative to the level-a run at dt)
+    np.testing.assert_allclose(e_in, D * (dt / 2) ** 2 / qa(te[te <= 1.0 + 1e-9]), rtol=1e-9)
+    np.testing.assert_allclose(e_out, D * dt**2 / qa(te[te > 1.0 + 1e-9]), rtol=1e-9)
+    # the Richardson correction C h_b^2 relative to the reference, both sides
+    np.testing.assert_allclose(u, C * 0.18**2 / qx[1:], rtol=1e-9)
+    assert tu[0] > 0 and np.all(np.diff(tu) > 0) and np.all(np.diff(te) > 0)
+    # a refinement at other levels than the scene's is refused, not mixed in
+    entry["refined"]["b"] = run(0.2, dt / 2, 1.0)
+    with pytest.raises(RuntimeError, match="levels"):
+        ars._series_errors(entry, "film_min")
+
+
+def test_the_pair_estimate_is_exact_on_an_order_two_error(bench):
+    """q(level) = f + C level^2: the pair estimate of the finer run is its error C l_b^2 / q_b."""
+    t = np.round(np.arange(0.0, 2.0 + 1e-9, 0.01), 12)
+    f = 0.3 + 0.1 * np.cos(2 * t)
+
+    def run(level):
+        series = (f + 0.02 * level**2).tolist()
+        return {"level": level, "t": t.tolist(), **{q: series for q in bench.QUANTITIES}}
+
+    est = bench.pair_estimate(run(1.41), run(0.5), t_from=0.04)
+    keep = t >= 0.04
+    assert est == pytest.approx(np.max(0.02 * 0.25 / (f[keep] + 0.005)), rel=1e-9)

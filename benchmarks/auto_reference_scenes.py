@@ -410,6 +410,8 @@ def _refined_errors(rf: dict, q: str, ratio: float, ta, tu, u, te, e, qx):
     fa, fb, fd = rf["a"], rf["b"], rf["a_dt"]
     if not math.isclose(fa["level"] / fb["level"], ratio) or not math.isclose(fd["level"], fa["level"]):
         raise RuntimeError("refined reference: its levels are not the scene's (redo the refinement)")
+    if fd.get("elements") != fa.get("elements"):
+        raise RuntimeError("refined reference: its two steps ran on different meshes (redo the refinement)")
     tf = np.asarray(fa["t"])
     if np.asarray(fb["t"]).shape != tf.shape or np.max(np.abs(np.asarray(fb["t"]) - tf)) > 1e-9:
         raise RuntimeError("refined reference: the two levels have different times")
@@ -626,11 +628,12 @@ def refine(name: str, data: dict, log) -> None:
     """The refinement of scene ``name`` (:data:`REFINE`, or the one it shares,
     :data:`REFINE_SHARED`): the refined runs that are missing, then its reference again.
 
-    The base reference (runs a, b, a_dt2) must be done.  The refined runs are kept in the
-    source scene's entry (``refined``: ``t_end``, ``dt``, ``reason``, runs ``a``, ``b``,
-    each with its wall time and machine); a sharing scene gets a copy of their series
-    (``source`` names the scene) and ``a_dt``, the source's level-L_a run at the scene's step
-    up to ``t_end``, for the time error."""
+    The base reference (runs a, b, a_dt2) must be done.  Three runs over ``t <= t_end``,
+    on today's fitted meshes (which may have changed since the base runs: their element
+    counts are recorded): ``a`` and ``b`` at the refined ``dt``, and ``a_dt``, level L_a at
+    the scene's own step, for the time error.  They are kept in the source scene's entry
+    (``refined``: ``t_end``, ``dt``, ``reason`` and the runs, each with its wall time and
+    machine); a sharing scene gets a copy of their series (``source`` names the scene)."""
     source = REFINE_SHARED.get(name, name)
     if source not in REFINE:
         raise SystemExit(
@@ -644,10 +647,10 @@ def refine(name: str, data: dict, log) -> None:
     la, lb = src["levels"]
     rf = src.setdefault("refined", {})
     rf.update(t_end=spec["t_end"], dt=spec["dt"], reason=spec["reason"])
-    for key, lev in (("a", la), ("b", lb)):
+    for key, lev, dt in (("a", la, spec["dt"]), ("b", lb, spec["dt"]), ("a_dt", la, scene_dt(source))):
         if "t" in rf.get(key, {}):
             continue
-        run = run_child(source, lev, spec["dt"], spec["t_end"])
+        run = run_child(source, lev, dt, spec["t_end"])
         log(
             f"{source} refined {key}: level {lev}, dt {spec['dt']}, t <= {spec['t_end']}: "
             f"{run.get('wall_s')} s"
@@ -661,18 +664,14 @@ def refine(name: str, data: dict, log) -> None:
         save(data, [source])
 
     def kept(run):
-        t = run["t"]
-        n = sum(1 for v in t if v <= spec["t_end"] + 1e-9)
-        return {k: run[k][:n] for k in _SERIES} | {"level": run["level"], "dt": run["dt"]}
+        return {k: run[k] for k in (*_SERIES, "level", "dt", "elements")}
 
-    rf["a_dt"] = kept(src["runs"]["a"])
     if name != source:
         entry = scenes[name]
         entry["refined"] = {
             **{k: rf[k] for k in ("t_end", "dt", "reason")},
             "source": source,
-            **{k: kept(rf[k]) for k in ("a", "b")},
-            "a_dt": rf["a_dt"],
+            **{k: kept(rf[k]) for k in ("a", "b", "a_dt")},
         }
     for n in dict.fromkeys((source, name)):
         reference(scenes[n])

@@ -182,6 +182,11 @@ def test_a_refined_reference_replaces_its_window_only():
     entry["refined"]["b"] = run(0.2, dt / 2, 1.0)
     with pytest.raises(RuntimeError, match="levels"):
         ars._series_errors(entry, "film_min")
+    # ... and so is a time error measured across two meshes (the fitted mesh changed)
+    entry["refined"]["b"] = run(0.18, dt / 2, 1.0)
+    entry["refined"]["a"]["elements"], entry["refined"]["a_dt"]["elements"] = 137888, 91854
+    with pytest.raises(RuntimeError, match="meshes"):
+        ars._series_errors(entry, "film_min")
 
 
 def test_the_pair_estimate_is_exact_on_an_order_two_error(bench):

@@ -197,9 +197,10 @@ REFINE = {
         ),
     },
 }
-#: scene -> the scene whose refinement it takes: the same motion and the same fitted mesh
-#: over the refinement's ``t_end`` (checked: their runs at both levels agree there to
-#: 1e-6 relative, the fast operator's tolerance)
+#: scene -> the scene whose refinement it takes: the same scene up to the refinement's
+#: ``t_end`` (the same motion there, so the same solution; also the same fitted meshes,
+#: 137,888 elements each at level 0.25 on 2026-12-05, and their base runs at both levels
+#: agree there to 1e-6 relative, the fast operator's tolerance)
 REFINE_SHARED = {"sphere_b2000_sliding": "sphere_b2000_approach"}
 #: what a refinement keeps of a run: the series
 _SERIES = ("t", *QUANTITIES)

@@ -722,8 +722,13 @@ Notes
   levels (1, 0.7), 24,736 and 50,120 elements, at dt = 0.0025: the film_min correction
   is 1.18 % at t = 0.715 in the approach (three levels not monotone there: not yet
   asymptotic) and 1.74 % at t = 1.985 in the sliding (observed order 2.8), time error
-  0.39 %.  A check of tol = 1e-2 there is as uncertain as the tolerance.
-* Levels (1, 0.7) for beta = 20000 (the capped mesh at level 0.5 would have about
+  0.39 %.  A check of tol = 1e-2 there is as uncertain as the tolerance.  The approach
+  again on 2026-12-05 at levels 0.5 and 0.357 (97,562 and 190,344 elements, dt = 0.0025,
+  level 0.7 the third): the film_min correction is 0.30 % (largest at t = 1.14; observed
+  order 1.8 at t = 1.5, 2.7 at that maximum: asymptotic now), the time error 0.38 %
+  (t = 0.545), 0.28 % at t = 1.5; the coarser pair (0.7, 0.5) extrapolates to within
+  0.67 % of it.
+* Levels (1, 0.7) for the beta = 20000 sliding (the capped mesh at level 0.5 has about
   100,000 elements over 800 steps).  With the fast operator (from 12,000 elements on)
   and a third, coarser level each, refined on 2026-12-02: beta = 2000 (0.25, 0.18),
   steady_b1000 (0.5, 0.35) and

@@ -382,19 +382,18 @@ def targets(records: list, refs: dict) -> list:
 
 def pair_estimate(a: dict, b: dict, t_from: float) -> float:
     """The automatic mode's estimate of the finer fixed-step run ``b`` from the coarser ``a``
-    (same steps): worst over the quantities of ``max_t |q_b - q_a| / (r^2 - 1) / scale``,
-    ``r`` the level ratio, over the times ``t >= t_from`` (the compared window)."""
+    (records with ``level``, ``t`` and the series): ``femehl.auto.pair_error``, worst over the
+    quantities and over the times ``t >= t_from`` (the compared window)."""
+    from types import SimpleNamespace
+
     import numpy as np
 
-    t = np.asarray(b["t"])
-    keep = t >= t_from - 1e-9
-    worst = 0.0
-    for q in QUANTITIES:
-        qa, qb = np.asarray(a[q])[keep], np.asarray(b[q])[keep]
-        scale = np.maximum(np.abs(qb), 0.1 if q == "load" else 0.0)
-        r = a["level"] / b["level"]
-        worst = max(worst, float(np.max(np.abs(qb - qa) / scale)) / (r**2 - 1.0))
-    return worst
+    from femehl.auto import CompanionSeries, pair_error
+
+    fine = SimpleNamespace(t=np.asarray(b["t"]), **{q: np.asarray(b[q]) for q in QUANTITIES})
+    coarse, ratio = CompanionSeries(a), a["level"] / b["level"]
+    keep = fine.t >= t_from - 1e-9
+    return max(float(np.max(pair_error(fine, coarse, q, ratio)[keep])) for q in QUANTITIES)
 
 
 def cost_target(records: list, refs: dict, scene: str = "paper", tol: float = 1e-2) -> list:
@@ -406,8 +405,8 @@ def cost_target(records: list, refs: dict, scene: str = "paper", tol: float = 1e
     estimate sees the space error only; the time error is then the same in both), the finer
     one's pair estimate (:func:`pair_estimate`) at most ``femehl.auto.ACCEPT * tol`` and at
     least its worst true error (an estimate that does not bound the error certifies
-    nothing).  The grid is coarse (levels 1.41, 1, 0.71, 0.5), so this is the grid's figure,
-    not a bound over every level."""
+    nothing).  The grid has the levels :data:`HAND_LEVELS` and :data:`HAND_LEVELS_PAPER`, so
+    this is the grid's figure, not a bound over every level."""
     from femehl.auto import ACCEPT
 
     ref = _ref(refs, scene)

@@ -322,7 +322,7 @@ def _print_choice(res) -> None:
         for n, k, w in zip(a["elements"], a["steps"], a["wall"], strict=True)
     )
     status = "reached" if a["reached"] else f"NOT reached ({a.get('stopped') or 'budget'})"
-    accepted = 100 * a.get("accept", 1.0) * a["tol"]
+    accepted = 100 * a["accept"] * a["tol"]
     print(
         f"femehl: automatic to tol = {a['tol']:g} ({status}): runs {runs}; the answer is the last "
         f"(estimated error up to {100 * a.get('total', float('nan')):.2g} %, accepted at <= {accepted:.2g} %)"

@@ -273,7 +273,7 @@ def _automatic(
             )
             + f"; estimated error {a.get('total', float('nan')):.2g} "
             + ("(tol reached" if a["reached"] else "(tol NOT reached")
-            + f": accepted at <= {a.get('accept', 1.0):g} tol)"
+            + f": accepted at <= {a['accept']:g} tol)"
         )
     return res
 

@@ -301,8 +301,7 @@ def companion_run(scene, method, options, t_end, dt, tol, controls) -> tuple:
     method's :attr:`Ladder.companion` discretization.  A companion that stops (its
     coarser mesh may not resolve the film) is logged and gives no space estimate.
     """
-    from .api import make_stepper, run_loop
-    from .errors import SolverError
+    from .loop import make_stepper, run_loop
 
     ladder = LADDERS.get(method)
     plan = ladder.companion(scene, options) if ladder is not None and ladder.companion else None
@@ -395,14 +394,26 @@ def _where(est: dict) -> str:
 
 # ---- the driver --------------------------------------------------------------------------
 def _run(
-    scene, method, ladder, t_end, level, store_every, options, runner=None, previous=None, deadline=None
+    scene,
+    method,
+    ladder,
+    t_end,
+    level,
+    store_every,
+    options,
+    runner=None,
+    previous=None,
+    deadline=None,
+    progress=None,
 ) -> Result:
     """One adaptive run at ``level`` (its discretization from ``ladder``).
 
     ``runner(level=, tol_t=, options=, previous=)`` makes the runs that may be accepted
     (a run folder writes them as they go); the others, and all of them without a
-    runner, run in memory.  A run in memory still going at ``deadline``
-    (``time.perf_counter()``) raises :class:`_OutOfTime`.
+    runner, run in memory through the one loop (:func:`femehl.loop.run_loop`).  A run in
+    memory still going at ``deadline`` (``time.perf_counter()``) raises
+    :class:`_OutOfTime`.  ``progress(desc, t_end)``, when given, makes a State handler with
+    a ``close()`` (a progress bar) for a run in memory.
     """
     t0 = time.perf_counter()
     tol_t = time_tolerance(level)
@@ -410,12 +421,26 @@ def _run(
     if runner is not None and previous is not None:
         res = runner(level=level, tol_t=tol_t, options=disc, previous=previous)
     else:
-        from .api import solve
+        from .core.adaptive import CONTROLS
+        from .loop import make_stepper, run_loop
 
+        handlers = [disc.pop("callback", None)]
+        controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
+        stepper = make_stepper(scene, method, **{"scheme": "bdf2", **disc})
+        bar = None
+        if progress is not None:
+            bar = progress(f"pilot level {level:.3g} ({stepper.info.get('elements', '?')} cells)", t_end)
+            handlers.append(bar)
+        on_state = _chain(handlers)
         if deadline is not None:
-            disc["callback"] = _deadline_guard(deadline, disc.get("callback"))
-        # the expert path with this level's discretization; the estimate is the pair's
-        res = solve(scene, method, t_end=t_end, tol=tol_t, store_every=store_every, estimate=False, **disc)
+            on_state = _deadline_guard(deadline, on_state)
+        try:
+            res = run_loop(
+                stepper, t_end, None, tol=tol_t, store_every=store_every, on_state=on_state, **controls
+            )
+        finally:
+            if bar is not None:
+                bar.close()
     n = int(res.info["elements"]) if "elements" in res.info else int(ladder.cells(scene, t_end, level))
     res.info.update(level=level, elements=n, tol_t=tol_t, wall=time.perf_counter() - t0)
     logger.info(
@@ -427,6 +452,21 @@ def _run(
         res.info["wall"],
     )
     return res
+
+
+def _chain(handlers):
+    """One State handler calling each of ``handlers`` (None entries skipped), or None."""
+    handlers = [h for h in handlers if h is not None]
+    if not handlers:
+        return None
+    if len(handlers) == 1:
+        return handlers[0]
+
+    def each(state):
+        for h in handlers:
+            h(state)
+
+    return each
 
 
 def _next_level(level: float, err: float, tol: float) -> float:
@@ -561,6 +601,7 @@ def solve_to_tolerance(
     level: float = LEVEL0,
     runner=None,
     on_run: Callable[[Result], None] | None = None,
+    progress=None,
     **options,
 ) -> Result:
     """Run ``scene`` to ``t_end`` with the load and films to about ``tol`` relative.
@@ -578,9 +619,10 @@ def solve_to_tolerance(
     :func:`femehl.solve` (not the discretization's,
     nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run;
     ``on_run(result)`` with every finished run, pilots included (its scalars stay; its
-    fields are dropped once a finer run supersedes it).
+    fields are dropped once a finer run supersedes it); ``progress(desc, t_end)`` makes
+    a progress handler (a State callable with ``close()``) for each run in memory.
     """
-    from .api import _registry
+    from .loop import _registry
 
     method = scene.default_method if method is None else method
     if method not in LADDERS:
@@ -653,7 +695,19 @@ def solve_to_tolerance(
         candidate = len(runs) >= MIN_RUNS - 1
         previous = runs[-1] if candidate else None
         try:
-            res = _run(scene, method, ladder, t_end, level, store_every, options, runner, previous, deadline)
+            res = _run(
+                scene,
+                method,
+                ladder,
+                t_end,
+                level,
+                store_every,
+                options,
+                runner,
+                previous,
+                deadline,
+                progress,
+            )
         except _OutOfTime as exc:
             stopped = "time budget"
             if not runs:

@@ -28,6 +28,7 @@ from .output import RunWriter, checkpoint, draw_figures
 from .output._validation import check_flag, check_resume_overwrite, check_run_options, check_tol
 from .output.folder import check_folder, prepare_folder
 from .result import Result
+from .threads import one_blas_thread
 
 __all__ = ["run_to_folder"]
 
@@ -98,6 +99,7 @@ def _redraw_history(folder: pathlib.Path) -> None:
         logger.warning("femehl: could not redraw %s/history.png (%s: %s)", folder, type(exc).__name__, exc)
 
 
+@one_blas_thread
 def run_to_folder(
     scene,
     folder,
@@ -256,7 +258,14 @@ def _automatic(
         say(f"femehl: automatic run to tol = {tol:g} (pilot runs in memory, then the run itself)")
         try:
             res = auto.solve_to_tolerance(
-                scene, t_end=t_end, tol=tol, method=method, store_every=store_every, runner=runner, **options
+                scene,
+                t_end=t_end,
+                tol=tol,
+                method=method,
+                store_every=store_every,
+                runner=runner,
+                progress=_pilot_bar if common.get("progress") else None,
+                **options,
             )
         except SolverError as exc:
             say(f"femehl: run stopped at t = {exc.t}: {exc}")
@@ -276,6 +285,12 @@ def _automatic(
             + f": accepted at <= {a['accept']:g} tol)"
         )
     return res
+
+
+def _pilot_bar(desc, t_end):
+    from .output.progress import TimeBar
+
+    return TimeBar(f"femehl {desc}", t_end)
 
 
 def _expert_estimate(scene, folder, res, dt, tol, options, t_end, say) -> None:
@@ -369,16 +384,13 @@ def _stream(
         checkpoint.write_params(folder, params)
     bar = None
     if progress:
-        from tqdm import tqdm
+        from .output.progress import TimeBar
 
-        done = 0 if start is None else round(start.t / step)
-        total = nsteps if tol is None else None  # adaptive: the number of steps is not known
-        bar = tqdm(
-            total=total,
-            initial=done if tol is None else 0,
-            unit="step",
-            desc=f"femehl {stepper.method}",
-            leave=True,
+        what = f"level {auto_plan['level']:.3g}, " if auto_plan is not None else ""
+        bar = TimeBar(
+            f"femehl {stepper.method} ({what}{stepper.info.get('elements', '?')} cells)",
+            t_end,
+            0.0 if start is None else float(start.t),
         )
     last = {"state": None, "saved": None}
 
@@ -395,11 +407,8 @@ def _stream(
                 f"({exc.strerror or exc}): free space or fix permissions, then resume "
                 "(resume=True, --resume)."
             ) from exc
-        if bar is not None and state.step:
-            bar.update(1)
-            bar.set_postfix(
-                t=f"{state.t:.3g}", load=f"{state.load:.4g}", dmin=f"{state.film_min:.3g}", refresh=False
-            )
+        if bar is not None:
+            bar(state)
 
     result = None
     finished = False

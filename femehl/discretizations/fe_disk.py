@@ -16,6 +16,7 @@ symmetric in y; its load is doubled.
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -41,7 +42,12 @@ from ..substrates.base import OPERATORS, substrate_operators
 from . import register_method
 from ._p1p0 import P1P0
 
+logger = logging.getLogger("femehl")
+
 __all__ = ["FEDisc"]
+
+#: the elastic operator's set-up is reported (it takes seconds) from this many cells on
+LONG_SETUP_CELLS = 5_000
 
 
 #: the mesh name that asks for a mesh fitted to the scene (:func:`femehl.fe.fitted.fitted_disk`)
@@ -234,11 +240,20 @@ class FEDisc(P1P0):
         where T holds one exact term per unique edge, so a block of rows is T_block (S P).
         For a half disk the mirror images (orientation reversed) add -T_mirror S.
         """
+        t0, say = time.perf_counter(), self.nelements >= LONG_SETUP_CELLS
+        if say:
+            logger.info(
+                "femehl: building the %s elastic operator on %d cells ...", self.operator, self.nelements
+            )
         if self.operator == "fast":
             from ..hmatrix import FastCompliance
 
-            return FastCompliance(self, self.fast_options)
-        return self._dense_boussinesq()
+            op = FastCompliance(self, self.fast_options)
+        else:
+            op = self._dense_boussinesq()
+        if say:
+            logger.info("femehl: elastic operator built in %.1f s", time.perf_counter() - t0)
+        return op
 
     def _dense_boussinesq(self):
         ne = self.nelements

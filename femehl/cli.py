@@ -103,11 +103,17 @@ def _parser():
         "animation: GIF of the maps",
     )
     pl.add_argument("folder", help="the run's output folder (femehl run --out)")
-    pl.add_argument("--t", type=float, help="maps, centreline: the stored time to draw (default: the last)")
+    pl.add_argument(
+        "--t",
+        type=float,
+        help="maps, centreline: draw the stored time nearest T, and say which (default: the last); "
+        "a T outside the stored times is refused",
+    )
     pl.add_argument(
         "--out",
-        help="file to write (default: in the folder: history.png, maps[_tT].png, "
-        "centreline_tT.png, animation.gif)",
+        help="where to write: an existing folder, or a name ending in / (a folder, created), gets the "
+        "usual file name inside it; anything else is the file (no suffix: .png, animation .gif) "
+        "(default: in the run folder: history.png, maps[_tT].png, centreline_tT.png, animation.gif)",
     )
     pl.add_argument("--fps", type=int, default=8, help="animation: frames per second (default 8)")
     sw = sub.add_parser(
@@ -118,7 +124,9 @@ def _parser():
         "args", nargs="+", metavar="SWEEP.toml | plot OUT", help="a sweep file, or plot and its output folder"
     )
     sw.add_argument("--scheduler", help="address of an existing Dask scheduler (default: a local cluster)")
-    sw.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
+    sw.add_argument(
+        "--workers", type=int, help="local cluster: worker processes, a positive integer (default: the cores)"
+    )
     sw.add_argument(
         "--memory-limit", help="local cluster: memory per worker, e.g. 4GiB (default: a share of RAM)"
     )
@@ -274,7 +282,12 @@ def _plot(args) -> int:
 
 
 def _sweep(args) -> int:
-    """``femehl sweep SWEEP.toml`` (run) or ``femehl sweep plot OUT`` (master curves)."""
+    """``femehl sweep SWEEP.toml`` (run) or ``femehl sweep plot OUT`` (master curves).
+
+    Exit status: 0 every case done, 2 a bad sweep (nothing started), 3 some cases failed
+    (the others are written; their keys and errors are printed), 130 interrupted (the
+    finished cases stay; the command that goes on is printed).
+    """
     from . import sweeps as sw
 
     if args.args[0] == "plot":
@@ -289,19 +302,28 @@ def _sweep(args) -> int:
         return EXIT_DONE
     if len(args.args) != 1:
         raise FemehlError("femehl sweep takes one sweep file (or: femehl sweep plot OUT).")
-    plan = sw.load_sweep_file(args.args[0])
-    cluster = plan.spec.get("cluster", {})
-    table = sw.sweep(
-        plan=plan,
-        scheduler=args.scheduler or cluster.get("scheduler"),
-        workers=args.workers or cluster.get("workers"),
-        memory_limit=args.memory_limit or cluster.get("memory_limit"),
-        overwrite=args.overwrite,
-        retry_failed=args.retry_failed,
-        progress=not args.quiet,
-    )
+    plan = None
+    try:
+        plan = sw.load_sweep_file(args.args[0])
+        cluster = plan.spec.get("cluster", {})
+
+        def given(flag, key):  # the command line's value, else the file's (0 is a value, refused)
+            return flag if flag is not None else cluster.get(key)
+
+        table = sw.sweep(
+            plan=plan,
+            scheduler=given(args.scheduler, "scheduler"),
+            workers=given(args.workers, "workers"),
+            memory_limit=given(args.memory_limit, "memory_limit"),
+            overwrite=args.overwrite,
+            retry_failed=args.retry_failed,
+            progress=not args.quiet,
+        )
+    except KeyboardInterrupt:
+        return _sweep_interrupted(args, plan)
     info = table.attrs["sweep"]
-    status = table.drop_duplicates("case")["status"].value_counts().to_dict()
+    cases = table.drop_duplicates("case")
+    status = cases["status"].value_counts().to_dict()
     eff = info["cases_s"] / info["wall_s"] if info["wall_s"] > 0 and info["ran"] else float("nan")
     print(
         f"femehl: sweep of {len(plan.cases)} cases ({info['ran']} run, {info['skipped']} finished before): "
@@ -309,7 +331,59 @@ def _sweep(args) -> int:
         + f"; {info['wall_s']:.1f} s wall for {info['cases_s']:.1f} s of cases "
         f"({eff:.2f} cases running on average); wrote {plan.out}/results.parquet"
     )
-    return EXIT_DONE
+    bad = cases[cases["status"] != "done"]
+    if bad.empty:
+        return EXIT_DONE
+    params = {c.key: c.params for c in plan.cases}
+    print(f"femehl: {len(bad)} of {len(cases)} cases did not finish:", file=sys.stderr)
+    for _, row in bad.head(20).iterrows():
+        shown = ", ".join(f"{k} = {v!r}" for k, v in params.get(row["case"], {}).items())
+        error = str(row["error"] or row["status"]).splitlines()[0]
+        print(f"  {row['case']} ({shown}): {row['status']}: {error}", file=sys.stderr)
+    if len(bad) > 20:
+        print(f"  ... and {len(bad) - 20} more (the status column of results.parquet)", file=sys.stderr)
+    print(
+        f"  their logs: {plan.out}/cases/<key>/run.log; the finished cases are written. To run the "
+        f"failed ones again:\n  {_sweep_command(args, '--retry-failed')}",
+        file=sys.stderr,
+    )
+    return EXIT_STOPPED
+
+
+def _sweep_command(args, *extra) -> str:
+    """The ``femehl sweep`` command line of ``args``, plus ``extra``."""
+    words = ["femehl", "sweep", args.args[0]]
+    words += ["--overwrite"] if args.overwrite else []  # harmless again: finished cases are reused
+    for flag, value in (
+        ("--scheduler", args.scheduler),
+        ("--workers", args.workers),
+        ("--memory-limit", args.memory_limit),
+    ):
+        if value is not None:
+            words += [flag, str(value)]
+    words += [w for w, on in (("--retry-failed", args.retry_failed), ("--quiet", args.quiet)) if on]
+    words += [w for w in extra if w not in words]
+    return shlex.join(words)
+
+
+def _sweep_interrupted(args, plan) -> int:
+    """Ctrl-C during a sweep: how many cases finished (they stay) and the command that goes on."""
+    from . import sweeps as sw
+
+    if plan is None:
+        print("femehl: interrupted while reading the sweep; nothing was started.", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    done = 0
+    for c in plan.cases:
+        rec = sw.read_case(plan.out / "cases" / c.key)
+        done += rec is not None and rec.get("key") == c.key and rec.get("status") in sw.FINISHED
+    print(
+        f"femehl: interrupted; {done} of {len(plan.cases)} cases finished and stay in {plan.out}/cases "
+        f"(the cases that were running start again). Rerunning goes on where it stopped (finished cases "
+        f"are skipped):\n  {_sweep_command(args)}",
+        file=sys.stderr,
+    )
+    return EXIT_INTERRUPTED
 
 
 def _print_choice(res) -> None:

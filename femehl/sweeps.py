@@ -97,10 +97,19 @@ RESULT_COLUMNS = (
 #: statuses a case.json can have; "done" and "failed" are finished (skipped on a re-run)
 FINISHED = ("done", "failed")
 DEFAULT_OUT = "femehl-out/sweeps"
+#: the most cases a sweep may have (counted before the grid is expanded); raise it with
+#: ``max_cases`` (``[sweep] max_cases = N``) or split the sweep into several
+MAX_CASES = 10_000
+#: run options the sweep sets itself (each case runs into its own folder)
+_SWEEP_SETS = ("folder", "resume", "overwrite", "progress", "log")
 
 
 class SweepError(SceneError):
     """A sweep description that cannot run (unknown field, empty grid, bad value)."""
+
+
+class _NameError(SweepError):
+    """A parameter name that addresses nothing (the same for every case: raised at once)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -174,6 +183,11 @@ def _sample(spec: dict) -> list[dict]:
     n, seed = spec.pop("n", None), spec.pop("seed", 0)
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise SweepError(f"[sample] needs n = number of cases (an integer >= 1), got {n!r}.")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise SweepError(
+            f"[sample] seed must be an integer >= 0, got {seed!r} ({type(seed).__name__}): give e.g. "
+            "seed = 1, or leave it out for 0."
+        )
     if not spec:
         raise SweepError('[sample] names no parameter: add e.g. "fluid.beta" = { loguniform = [20, 20000] }.')
     rng = np.random.default_rng(seed)
@@ -194,8 +208,52 @@ def _sample(spec: dict) -> list[dict]:
     return [{k: cols[k][i] for k in cols} for i in range(n)]
 
 
-def expand(grid: dict | None = None, cases: list | None = None, sample: dict | None = None) -> list[dict]:
-    """The parameter dicts of a sweep: the grid's every combination, a list, or a sample."""
+def _count(name, spec) -> int:
+    """How many values a grid entry has, without making them (a huge ``num`` is not allocated)."""
+    if isinstance(spec, list):
+        return len(spec)
+    if isinstance(spec, dict) and ("logspace" in spec or "linspace" in spec):
+        num = spec.get("num")
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            kind = "logspace" if "logspace" in spec else "linspace"
+            raise SweepError(
+                f"grid {name!r}: give {{{kind} = [first, last], num = N}} with two numbers and N >= 1, "
+                f"got {spec!r}."
+            )
+        return num
+    return 1
+
+
+def check_max_cases(max_cases) -> int:
+    """``max_cases`` (None: :data:`MAX_CASES`) as a positive integer."""
+    if max_cases is None:
+        return MAX_CASES
+    if isinstance(max_cases, bool) or not isinstance(max_cases, int) or max_cases < 1:
+        raise SweepError(
+            f"max_cases must be a positive integer, got {max_cases!r} ({type(max_cases).__name__}): "
+            f"give e.g. max_cases = 20000, or leave it out for {MAX_CASES}."
+        )
+    return max_cases
+
+
+def _too_many(n: int, what: str, max_cases: int) -> None:
+    if n > max_cases:
+        raise SweepError(
+            f"the sweep has {n:,} cases ({what}), more than the limit of {max_cases:,}: split it into "
+            "several sweeps (each with its own out), or raise the limit with max_cases = N in [sweep] "
+            "(plan_sweep(..., max_cases=N)) if this many runs is meant."
+        )
+
+
+def expand(
+    grid: dict | None = None, cases: list | None = None, sample: dict | None = None, max_cases=None
+) -> list[dict]:
+    """The parameter dicts of a sweep: the grid's every combination, a list, or a sample.
+
+    The number of cases is counted first: more than ``max_cases`` (default
+    :data:`MAX_CASES`) is refused before anything is expanded.
+    """
+    max_cases = check_max_cases(max_cases)
     given = [x is not None for x in (grid, cases, sample)]
     if sum(given) != 1:
         raise SweepError("a sweep needs exactly one of grid (every combination), cases (a list) or sample.")
@@ -205,14 +263,22 @@ def expand(grid: dict | None = None, cases: list | None = None, sample: dict | N
                 "the grid is empty: give at least one parameter, e.g. {'fluid.beta': [20, 200]}."
             )
         names = list(grid)
+        counts = [_count(n, grid[n]) for n in names]
+        _too_many(
+            math.prod(counts), " x ".join(f"{c:,} {n}" for n, c in zip(names, counts, strict=True)), max_cases
+        )
         lists = [_values(n, grid[n]) for n in names]
         return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*lists)]
     if cases is not None:
         if not isinstance(cases, list) or not cases or not all(isinstance(c, dict) and c for c in cases):
             raise SweepError("cases must be a non-empty list of {name: value} tables.")
+        _too_many(len(cases), "the list of cases", max_cases)
         return [dict(c) for c in cases]
     if not isinstance(sample, dict):
         raise SweepError("sample must be a table: n, seed and {name = {uniform|loguniform = [a, b]}}.")
+    n = sample.get("n")
+    if isinstance(n, int) and not isinstance(n, bool):
+        _too_many(n, "[sample] n", max_cases)
     return _sample(sample)
 
 
@@ -220,14 +286,14 @@ def expand(grid: dict | None = None, cases: list | None = None, sample: dict | N
 def _set_dotted(raw: dict, name: str, value) -> None:
     parts = name.split(".")
     if not all(parts):
-        raise SweepError(f"parameter {name!r}: a dotted name such as 'fluid.beta' (no empty parts).")
+        raise _NameError(f"parameter {name!r}: a dotted name such as 'fluid.beta' (no empty parts).")
     node = raw
     for i, part in enumerate(parts[:-1]):
         nxt = node.get(part)
         if nxt is None:
             nxt = node[part] = {}
         if not isinstance(nxt, dict):
-            raise SweepError(f"parameter {name!r}: {'.'.join(parts[: i + 1])} is a value, not a table.")
+            raise _NameError(f"parameter {name!r}: {'.'.join(parts[: i + 1])} is a value, not a table.")
         node = nxt
     node[parts[-1]] = copy.deepcopy(value)
 
@@ -237,7 +303,7 @@ def _replace_dotted(obj, name: str, value):
     head, _, rest = name.partition(".")
     if not dataclasses.is_dataclass(obj) or head not in {f.name for f in dataclasses.fields(obj)}:
         fields = sorted(f.name for f in dataclasses.fields(obj)) if dataclasses.is_dataclass(obj) else []
-        raise SweepError(
+        raise _NameError(
             f"parameter {name!r}: {type(obj).__name__} has no field {head!r}"
             + (f"; it has {fields}." if fields else ".")
         )
@@ -269,6 +335,71 @@ def _jsonable(v):
     return v
 
 
+def check_case_options(scene, options: dict) -> dict:
+    """Refuse, before anything runs, run options :func:`femehl.run.run_to_folder` would refuse.
+
+    The same checks as the run makes before it writes anything (the method and the scene,
+    ``t_end``/``dt``/``store_every``/``checkpoint_every``, ``tol``, ``max_wall``, the
+    options of the automatic mode against an expert run, option names the method does not
+    take), without building a mesh: a sweep of bad cases is refused before its cluster
+    starts.  Values only the discretization can judge (a mesh file's content) are still
+    found on the worker (the case is recorded as failed).
+    """
+    import inspect
+
+    from .api import AUTO_ONLY, is_automatic, refuse_auto_only
+    from .auto import check_max_wall
+    from .core.linsolve import LINEAR_SOLVERS
+    from .loop import _registry
+    from .output._validation import check_run_options, check_tol
+
+    if not all(isinstance(k, str) for k in options):
+        raise SceneError(f"run option names must be strings, got {sorted(map(repr, options))}.")
+    sets = sorted(k for k in options if k in _SWEEP_SETS)
+    if sets:
+        raise SceneError(
+            f"run option(s) {', '.join(sets)}: the sweep sets these itself (each case runs into its own "
+            "folder, finished cases are skipped); remove them from [run]."
+        )
+    methods = _registry()
+    method = options.get("method", getattr(scene, "default_method", "fe"))
+    if not isinstance(method, str) or method not in methods:
+        raise SceneError(f"unknown method {method!r}: choose one of {sorted(methods)}.")
+    if (method == "line") != (scene.default_method == "line"):
+        raise SceneError(
+            f"method {method!r} does not fit this scene (its method is {scene.default_method!r}): "
+            "leave method out, or give a scene of that kind."
+        )
+    check_tol(options.get("tol"))
+    if "max_wall" in options:
+        check_max_wall(options["max_wall"])
+    dt = options.get("dt")
+    check_run_options(
+        options.get("t_end", 5.0),
+        0.01 if dt is None else dt,
+        options.get("store_every", 10),
+        options.get("checkpoint_every"),
+    )
+    rest = {
+        k: v
+        for k, v in options.items()
+        if k not in ("method", "t_end", "dt", "store_every", "checkpoint_every", "tol")
+    }
+    if not is_automatic(scene, method, dt, rest):
+        refuse_auto_only(rest)
+    takes = set(inspect.signature(methods[method]).parameters) - {"scene"}
+    takes |= {"scheme", "linear_solver", "terms"} | set(AUTO_ONLY)
+    for sol in LINEAR_SOLVERS.values():
+        takes |= set(inspect.signature(sol).parameters)
+    unknown = sorted(set(rest) - takes)
+    if unknown:
+        raise SceneError(
+            f"method {method!r} does not take the run option(s) {unknown}: check the spelling; it takes "
+            f"{sorted(takes | {'t_end', 'dt', 'tol', 'store_every', 'checkpoint_every', 'method'})}."
+        )
+    return options
+
+
 def plan_sweep(
     base=None,
     grid: dict | None = None,
@@ -278,6 +409,7 @@ def plan_sweep(
     run: dict | None = None,
     out=None,
     base_path=None,
+    max_cases=None,
 ) -> SweepPlan:
     """Every case of a sweep, built and checked before anything runs.
 
@@ -297,16 +429,25 @@ def plan_sweep(
         Output folder (default ``femehl-out/sweeps/sweep``).
     base_path : path, optional
         The file a dict ``base`` came from (messages, relative paths).
+    max_cases : int, optional
+        The most cases allowed (default :data:`MAX_CASES`), counted before expanding.
 
     Raises
     ------
     SweepError
-        An unknown field, an empty grid, a value the scene refuses: naming the parameter.
+        An unknown field, an empty grid, too many cases, a value the scene refuses, a run
+        option a case refuses (:func:`check_case_options`): naming the parameter, and
+        every case that cannot run.
     """
     from . import presets
     from .scenefile import run_options, scene_from_mapping
 
-    params_list = expand(grid, cases, sample)
+    params_list = expand(grid, cases, sample, max_cases)
+    if run is not None and not isinstance(run, dict):
+        raise SweepError(
+            f"run must be a table of run options (e.g. {{t_end = 8.0, tol = 0.01}}), got {run!r} "
+            f"({type(run).__name__})."
+        )
     run = dict(run or {})
     raw = None
     if isinstance(base, (str, os.PathLike)):
@@ -323,35 +464,42 @@ def plan_sweep(
         raw = base
     elif base is None:
         base = presets.paper_sphere()
+    elif not dataclasses.is_dataclass(base) or not hasattr(base, "default_method"):
+        raise SweepError(
+            f"base must be a Scene, a scene file's path or its tables (a dict), or None (the paper "
+            f"case), got {type(base).__name__}."
+        )
     where = pathlib.Path(base_path) if base_path is not None else pathlib.Path("sweep.toml")
-    built, names = [], list(dict.fromkeys(k for p in params_list for k in p))
+    built, names, bad = [], list(dict.fromkeys(k for p in params_list for k in p)), []
     for params in params_list:
         scene_p, run_p = _split_run(params)
-        if raw is not None:
-            case_raw = copy.deepcopy(raw)
-            for k, v in scene_p.items():
-                _set_dotted(case_raw, k, v)
-            try:
+        try:
+            if raw is not None:
+                case_raw = copy.deepcopy(raw)
+                for k, v in scene_p.items():
+                    _set_dotted(case_raw, k, v)
                 scene, file_run = scene_from_mapping(case_raw, where)
-            except FemehlError as exc:
-                raise SweepError(f"case {_show(params)}: {exc}") from None
-            file_run.pop("_dimensional", None)
-            try:
+                file_run.pop("_dimensional", None)
                 options = run_options({**file_run, **run, **run_p})
-            except FemehlError as exc:
-                raise SweepError(f"case {_show(params)}: {exc}") from None
-        else:
-            scene = base
-            for k, v in scene_p.items():
-                try:
+            else:
+                scene = base
+                for k, v in scene_p.items():
                     scene = _replace_dotted(scene, k, v)
-                except SweepError:
-                    raise
-                except (FemehlError, TypeError, ValueError) as exc:
-                    raise SweepError(f"case {_show(params)}: {exc}") from None
-            options = {**run, **run_p}
-        options.setdefault("store_every", 10)
+                options = {**run, **run_p}
+            options.setdefault("store_every", 10)
+            check_case_options(scene, options)
+        except _NameError:
+            raise
+        except (FemehlError, TypeError, ValueError) as exc:
+            bad.append(f"case {_show(params)}: {exc}")
+            continue
         built.append(Case(case_key(scene, options), _jsonable(params), scene, options))
+    if bad:
+        shown = "; ".join(bad[:5]) + (f"; and {len(bad) - 5} more" if len(bad) > 5 else "")
+        raise SweepError(
+            f"{len(bad)} of {len(params_list)} cases cannot run (nothing was started): {shown}. "
+            "Fix the values (the grid, [run] or the run.* parameters) and run the sweep again."
+        )
     keys = [c.key for c in built]
     if len(set(keys)) < len(keys):
         raise SweepError(
@@ -380,9 +528,42 @@ def load_sweep_file(path) -> SweepPlan:
     known = {"sweep", "grid", "cases", "sample", "run", "cluster"}
     if set(raw) - known:
         raise SweepError(f"{path}: unknown table(s) {sorted(set(raw) - known)}; known: {sorted(known)}.")
+    for name in known - {"cases"}:
+        if name in raw and not isinstance(raw[name], dict):
+            raise SweepError(
+                f"{path}: {name} must be a table ([{name}] with key = value lines), got {raw[name]!r} "
+                f"({type(raw[name]).__name__}): write it as a [{name}] section."
+            )
+    if "cases" in raw and not (
+        isinstance(raw["cases"], list) and all(isinstance(c, dict) for c in raw["cases"])
+    ):
+        raise SweepError(
+            f"{path}: cases must be an array of tables ([[cases]] sections, each with name = value "
+            f"lines), got {raw['cases']!r}: write each case as a [[cases]] section."
+        )
     head = raw.get("sweep", {})
-    if set(head) - {"scene", "out"}:
-        raise SweepError(f"{path}: [sweep] takes scene and out, got {sorted(head)}.")
+    if set(head) - {"scene", "out", "max_cases"}:
+        raise SweepError(f"{path}: [sweep] takes scene, out and max_cases, got {sorted(head)}.")
+    for key, fix in (
+        ("scene", 'a path relative to this file, e.g. scene = "paper_sphere.toml"'),
+        ("out", 'a folder, e.g. out = "femehl-out/sweeps/beta"'),
+    ):
+        if key in head and (not isinstance(head[key], str) or not head[key].strip()):
+            raise SweepError(
+                f"{path}: [sweep] {key} must be a string (a path), got {head[key]!r} "
+                f"({type(head[key]).__name__}): give {fix}, in quotes."
+            )
+    try:
+        max_cases = check_max_cases(head.get("max_cases"))
+    except SweepError as exc:
+        raise SweepError(f"{path}: [sweep] {exc}") from None
+    cluster = raw.get("cluster", {})
+    if set(cluster) - {"scheduler", "workers", "memory_limit"}:
+        raise SweepError(f"{path}: [cluster] takes scheduler, workers, memory_limit; got {sorted(cluster)}.")
+    try:
+        check_cluster(cluster.get("scheduler"), cluster.get("workers"), cluster.get("memory_limit"))
+    except SweepError as exc:
+        raise SweepError(f"{path}: [cluster] {exc}") from None
     base = head.get("scene")
     base = (path.parent / base) if base is not None else None
     out = head.get("out", str(pathlib.Path(DEFAULT_OUT) / path.stem))
@@ -394,20 +575,58 @@ def load_sweep_file(path) -> SweepPlan:
             sample=raw.get("sample"),
             run=raw.get("run"),
             out=out,
+            max_cases=max_cases,
         )
     except SweepError as exc:
         raise SweepError(f"{path}: {exc}") from None
-    cluster = raw.get("cluster", {})
-    if set(cluster) - {"scheduler", "workers", "memory_limit"}:
-        raise SweepError(f"{path}: [cluster] takes scheduler, workers, memory_limit; got {sorted(cluster)}.")
     return dataclasses.replace(plan, spec={**plan.spec, "cluster": cluster})
+
+
+def check_cluster(scheduler=None, workers=None, memory_limit=None) -> None:
+    """Refuse cluster settings of the wrong type before anything starts (SweepError naming the fix).
+
+    ``scheduler``: an address string; ``workers``: a positive integer (None: one per
+    core; 0 is refused, not read as "all cores"); ``memory_limit``: a size such as
+    ``"4GiB"``, ``"auto"``, a number of bytes, or a fraction <= 1 of the machine's memory.
+    """
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
+        raise SweepError(
+            f"scheduler must be a string (a Dask scheduler address), got {scheduler!r} "
+            f'({type(scheduler).__name__}): give e.g. scheduler = "tcp://host:8786", or leave it out '
+            "for a local cluster."
+        )
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise SweepError(
+            f"workers must be a positive integer (local worker processes), got {workers!r} "
+            f"({type(workers).__name__}): give e.g. workers = 2 (--workers 2), or leave it out for one "
+            f"per core ({os.cpu_count() or 1} here)."
+        )
+    if memory_limit is None:
+        return
+    ok = False
+    if isinstance(memory_limit, str):
+        from dask.utils import parse_bytes
+
+        try:
+            ok = memory_limit == "auto" or parse_bytes(memory_limit) > 0
+        except (ValueError, TypeError):
+            ok = False
+    elif isinstance(memory_limit, (int, float)) and not isinstance(memory_limit, bool):
+        ok = math.isfinite(memory_limit) and memory_limit > 0
+    if not ok:
+        raise SweepError(
+            f'memory_limit must be a size such as "4GiB" (or "auto", a number of bytes, a fraction '
+            f"<= 1 of the memory), got {memory_limit!r} ({type(memory_limit).__name__}): give e.g. "
+            'memory_limit = "4GiB", or leave it out for a share of the memory.'
+        )
 
 
 # ---- one case (runs on a worker) ----------------------------------------------------------
 def _atomic_json(path: pathlib.Path, data: dict) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1, default=float))
-    os.replace(tmp, path)
+    from .output._files import write_atomic
+
+    text = json.dumps(data, indent=1, default=float)
+    write_atomic(path, lambda tmp: tmp.write_text(text))
 
 
 def read_case(folder) -> dict | None:
@@ -491,14 +710,23 @@ def run_case(case: Case, folder) -> dict:
 
 # ---- the sweep ---------------------------------------------------------------------------
 def _check_out(plan: SweepPlan, overwrite: bool) -> None:
-    plan.out.mkdir(parents=True, exist_ok=True)
+    from .output._files import writing
+
+    if plan.out.exists() and not plan.out.is_dir():
+        raise OutputError(f"{plan.out} is a file, not a folder: give another out for the sweep.")
+    with writing(plan.out, "create the sweep folder"):
+        plan.out.mkdir(parents=True, exist_ok=True)
     spec_file = plan.out / "sweep.json"
-    if spec_file.is_file() and not overwrite:
+    if spec_file.exists() and not overwrite:
         try:
             old = json.loads(spec_file.read_text())
-        except ValueError:
-            old = None
-        if old is None or old.get("cases") != plan.spec["cases"]:
+        except (OSError, ValueError):
+            raise OutputError(
+                f"{spec_file} is damaged (not readable JSON), so whether {plan.out} holds this sweep is "
+                "unknown: give overwrite=True (--overwrite) if it is this sweep's folder (finished case "
+                "folders are reused, the table is rewritten), or another out."
+            ) from None
+        if not isinstance(old, dict) or old.get("cases") != plan.spec["cases"]:
             raise OutputError(
                 f"{plan.out} holds another sweep (its sweep.json differs): give another out, or "
                 "overwrite=True (--overwrite) to replace its table (the case folders stay and are reused)."
@@ -518,9 +746,8 @@ def _client(scheduler, workers, memory_limit):
                 f"cannot reach the Dask scheduler at {scheduler!r} ({exc}): check the address, or leave "
                 "scheduler out to run on a local cluster."
             ) from None
-    n = workers or os.cpu_count() or 1
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise SweepError(f"workers must be an integer >= 1, got {workers!r}.")
+    check_cluster(scheduler, workers, memory_limit)
+    n = workers if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(
         n_workers=n,
         threads_per_worker=1,
@@ -579,6 +806,10 @@ def sweep(
     _need_extra()
     from distributed import as_completed
 
+    from .output._validation import check_flag
+
+    check_cluster(scheduler, workers, memory_limit)
+    overwrite, retry_failed = check_flag("overwrite", overwrite), check_flag("retry_failed", retry_failed)
     if plan is None:
         plan = plan_sweep(base, grid, cases=cases, sample=sample, run=run, out=out)
     _check_out(plan, overwrite)
@@ -586,6 +817,8 @@ def sweep(
     records, todo = {}, []
     for c in plan.cases:
         rec = read_case(plan.out / "cases" / c.key)
+        if rec is not None and rec.get("key") != c.key:
+            rec = None  # not this case's record (a damaged or misplaced case.json): run it
         again = rec is not None and rec.get("status") == "failed" and retry_failed
         if rec is not None and rec.get("status") in FINISHED and not again:
             records[c.key] = rec
@@ -595,6 +828,7 @@ def sweep(
         "femehl sweep: %d cases, %d finished before, %d to run", len(plan.cases), len(records), len(todo)
     )
     t0 = time.perf_counter()
+    interrupted = False
     if todo:
         client, cluster = _client(scheduler, workers, memory_limit)
         try:
@@ -628,6 +862,8 @@ def sweep(
                     bar.update(1)
             if bar is not None:
                 bar.close()
+        except KeyboardInterrupt:
+            interrupted = True  # the table of what finished is written below, then re-raised
         finally:
             client.close()
             if cluster is not None:
@@ -635,7 +871,9 @@ def sweep(
     wall = time.perf_counter() - t0
     table = _table(plan, records)
     _write_parquet(table, plan.out / "results.parquet")
-    ran = [records[c.key].get("wall_s", 0.0) or 0.0 for c in todo]
+    if interrupted:
+        raise KeyboardInterrupt
+    ran = [records[c.key].get("wall_s", 0.0) or 0.0 for c in todo if c.key in records]
     info = {
         "wall_s": wall,
         "cases_s": float(sum(ran)),
@@ -689,9 +927,9 @@ def _table(plan: SweepPlan, records: dict):
 
 
 def _write_parquet(df, path: pathlib.Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    df.to_parquet(tmp, index=False)
-    os.replace(tmp, path)
+    from .output._files import write_atomic
+
+    write_atomic(path, lambda tmp: df.to_parquet(tmp, index=False), "write the table")
 
 
 def read_results(out):

@@ -26,6 +26,7 @@ so ``femehl plot`` redraws them for any stored time without the run in memory.
 
 from __future__ import annotations
 
+import logging
 import pathlib
 
 import numpy as np
@@ -57,6 +58,8 @@ WINDOW = 2.5
 #: the film map's colour scale spans from the thinnest film to this many times it
 FILM_DECADES = 10.0
 
+logger = logging.getLogger("femehl")
+
 
 def _plt():
     import matplotlib
@@ -68,11 +71,32 @@ def _plt():
 
 
 def _save(plt, fig, path, dpi):
-    fig.tight_layout()
+    """Save ``fig`` to ``path`` (atomically: a failed write leaves the file there untouched);
+    a fault (unwritable folder, full disk) is an :class:`~femehl.errors.OutputError`."""
+    from ._files import write_atomic
+
     path = pathlib.Path(path)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    try:
+        fig.tight_layout()
+        fmt = path.suffix[1:].lower() or None
+        return write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt), "write the picture")
+    finally:
+        plt.close(fig)
+
+
+def figure_suffixes() -> frozenset:
+    """The file suffixes matplotlib can write a figure to (``.png``, ``.pdf``, ``.svg``, ...)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return frozenset("." + k for k in FigureCanvasBase.get_supported_filetypes())
+
+
+def _out(out, folder, name):
+    """The file ``--out`` names for the picture ``name`` (see :func:`femehl.output._files.out_path`)."""
+    from ._files import out_path
+
+    suffixes = {".gif"} if name.endswith(".gif") else figure_suffixes()
+    return out_path(out, folder, name, suffixes)
 
 
 def profile_times(result, wanted=(0.5, 0.8, 1.0, 1.5, 2.0, 5.0)):
@@ -457,8 +481,9 @@ def plot_centreline(folder, t=None, out=None):
     nearest ``t`` (default: the last), the cavitated interval(s) shaded."""
     from .snapshot import read_snapshot
 
-    snap = read_snapshot(folder, t)
-    path = out or pathlib.Path(folder) / centreline_name(snap.t)
+    _out(out, folder, "centreline.png")  # a bad --out is refused before anything is read
+    snap = read_snapshot(folder, t, what="centreline")
+    path = _out(out, folder, centreline_name(snap.t))
     return _save(_plt(), centreline_figure(snap, title=_title_of(folder)), path, dpi=100)
 
 
@@ -474,9 +499,11 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
     import matplotlib.tri as mtri
 
     plt = _plt()
+    from ..errors import OutputError
+
     get, count = snaps if isinstance(snaps, tuple) else ((lambda k: snaps[k]), len(snaps))
     if count < 1:
-        raise ValueError("no frames")
+        raise OutputError("an animation needs at least one stored time: the run stored no fields.")
     last = get(count - 1)
     W = _window(last)
     tri = mtri.Triangulation(last.points[:, 0], last.points[:, 1], last.triangles)
@@ -487,6 +514,20 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
     pnorm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-0.5 * top, vmax=1.2 * top)
     writer = manim.PillowWriter(fps=int(fps))
     path = pathlib.Path(path)
+    from ._files import write_atomic
+
+    def frames(tmp):
+        _animate(writer, fig, tmp, get, count, last, (ax_d, ax_p, ax_c), tri, dnorm, pnorm, W, top, title)
+
+    try:
+        return write_atomic(path, frames, "write the animation")
+    finally:
+        plt.close(fig)
+
+
+def _animate(writer, fig, path, get, count, last, axes, tri, dnorm, pnorm, W, top, title):
+    """The frames of :func:`animation_file`, grabbed into ``writer`` saving to ``path``."""
+    ax_d, ax_p, ax_c = axes
     with writer.saving(fig, str(path), dpi=80):
         for k in range(count):
             s = get(k) if k < count - 1 else last
@@ -513,8 +554,6 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
             if title:
                 fig.suptitle(title, fontsize=10)
             writer.grab_frame()
-    plt.close(fig)
-    return path
 
 
 def line_png(result, path):
@@ -604,16 +643,22 @@ def _title_of(folder) -> str:
 
 def plot_history(folder, out=None):
     """``history.png`` of a run folder from its ``summary.csv`` (``out``: another file)."""
+    from ..errors import OutputError
     from .snapshot import check_run_folder
     from .table import read_summary
 
     folder = check_run_folder(folder)
+    path = _out(out, folder, "history.png")
     table = read_summary(folder / "summary.csv")
+    missing = [c for c in ("load", "p_max", "hc", "V", "film_center", "film_min") if c not in table]
+    if missing:
+        raise OutputError(
+            f"{folder}/summary.csv has no column(s) {', '.join(missing)}: it is damaged or not "
+            "femehl's; rerun the case (femehl run --overwrite) to write it again."
+        )
     if table["t"].size < 2:
-        from ..errors import OutputError
-
         raise OutputError(f"{folder}/summary.csv has fewer than two steps: nothing to plot yet.")
-    return history_png(table, out or folder / "history.png", title=_title_of(folder))
+    return history_png(table, path, title=_title_of(folder))
 
 
 def maps_name(t: float | None) -> str:
@@ -625,27 +670,34 @@ def plot_maps(folder, t=None, out=None):
     """The contact maps of a run folder at the stored time nearest ``t`` (default: the last)."""
     from .snapshot import read_snapshot
 
-    snap = read_snapshot(folder, t)
-    name = maps_name(None if t is None else snap.t)
-    return maps_png(snap, out or pathlib.Path(folder) / name, title=_title_of(folder))
+    _out(out, folder, "maps.png")  # a bad --out is refused before anything is read
+    snap = read_snapshot(folder, t, what="maps")
+    path = _out(out, folder, maps_name(None if t is None else snap.t))
+    return maps_png(snap, path, title=_title_of(folder))
 
 
 def plot_animation(folder, out=None, fps: int = 8):
     """``animation.gif`` of a run folder: one frame per stored field file."""
     from ..errors import OutputError
-    from .snapshot import read_snapshot, stored_times
+    from .snapshot import damaged_files, read_snapshot, stored_times
 
     if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 60:
         raise OutputError(f"fps must be an integer from 1 to 60, got {fps!r}.")
     from .table import read_summary
 
-    read_snapshot(folder)  # a run folder with a readable series (else OutputError)
+    path = _out(out, folder, "animation.gif")
+    read_snapshot(folder, report=False)  # a run folder with a readable series (else OutputError)
+    damaged = damaged_files(folder)
+    if damaged:
+        logger.warning(
+            "femehl: %s damaged (incomplete) and left out of the animation; it shows the %d readable times",
+            ", ".join(damaged),
+            len(stored_times(folder)),
+        )
     times = [t for t, _ in stored_times(folder)]
     table = read_summary(pathlib.Path(folder) / "summary.csv")
-    frames = (lambda k: read_snapshot(folder, times[k], summary=table), len(times))
-    return animation_file(
-        frames, out or pathlib.Path(folder) / "animation.gif", fps=fps, title=_title_of(folder)
-    )
+    frames = (lambda k: read_snapshot(folder, times[k], summary=table, report=False), len(times))
+    return animation_file(frames, path, fps=fps, title=_title_of(folder))
 
 
 #: ``femehl plot WHAT FOLDER``: the drawers of a run folder's pictures

@@ -9,7 +9,7 @@ to read them: :attr:`femehl.cavitation.HalfSommerfeld.note`); film thickness ``d
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
 normalized; z = 0.  A half-disk run (computed on y >= 0) is written as the
-mirrored full disk (:func:`femehl.output.snapshot.mirror_half`: the nodes on
+mirrored full disk (:func:`femehl.output.mirror.mirror_half`: the nodes on
 y = 0 are shared, not duplicated), so ParaView shows the whole contact; the
 field data ``MirroredHalfDisk = 1`` says so (``mirror=False`` writes the half
 disk as computed, ``MirroredHalfDisk = 0``).
@@ -30,6 +30,8 @@ from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
+
+from .mirror import mirror_half
 
 __all__ = ["SeriesWriter", "field_value", "grid_cells", "read_index", "scan_series", "vtu_time"]
 
@@ -57,8 +59,6 @@ class SeriesWriter:
     """
 
     def __init__(self, folder, disc, stem: str = "fields", mirror: bool = True):
-        from .snapshot import mirror_half
-
         self.folder = pathlib.Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.disc = disc

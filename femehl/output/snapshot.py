@@ -17,48 +17,19 @@ same picture as the run did.
 
 from __future__ import annotations
 
+import logging
 import pathlib
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import OutputError
+from .mirror import mirror_half
+from .series import cavitated_nodes, field_value, scan_series
 
-__all__ = ["Snapshot", "mirror_half", "read_snapshot", "snapshot", "stored_times"]
+logger = logging.getLogger("femehl")
 
-#: nodes with |y| below this fraction of the mesh size are on the mirror line
-_ON_LINE = 1e-9
-
-
-def mirror_half(points, cells):
-    """The full disk of a half-disk mesh: ``(points, cells, source)``.
-
-    Parameters
-    ----------
-    points : (n, 3) array
-        Nodes of the half disk (y >= 0).
-    cells : list of (cell type, (m, k) int array)
-        Its cells.
-
-    Returns
-    -------
-    points : (n + n_off, 3) array
-        The nodes, then the images of the nodes off the line y = 0.
-    cells : list of (cell type, (2 m, k) int array)
-        The cells, then their images (vertex order reversed).
-    source : (n + n_off,) int array
-        For each full-disk node, the half-disk node whose values it carries.
-    """
-    points = np.asarray(points, dtype=float)
-    n = points.shape[0]
-    scale = float(np.max(np.abs(points[:, :2]))) if n else 1.0
-    off = np.flatnonzero(points[:, 1] > _ON_LINE * max(scale, 1e-300))
-    image = np.arange(n)
-    image[off] = n + np.arange(off.size)
-    flipped = points[off].copy()
-    flipped[:, 1] *= -1.0
-    out_cells = [(kind, np.vstack([c, image[c][:, ::-1]])) for kind, c in cells]
-    return np.vstack([points, flipped]), out_cells, np.concatenate([np.arange(n), off])
+__all__ = ["Snapshot", "damaged_files", "mirror_half", "read_snapshot", "snapshot", "stored_times"]
 
 
 @dataclass(frozen=True)
@@ -159,8 +130,6 @@ def _build(
 
 def snapshot(disc, state) -> Snapshot:
     """The :class:`Snapshot` of ``state`` (full disk: a half-disk run is mirrored)."""
-    from .series import cavitated_nodes
-
     points, cells, on_points = disc.vtk_geometry()
     p, d = np.asarray(state.p, dtype=float), np.asarray(state.d, dtype=float)
     cav = cavitated_nodes(disc, state)
@@ -182,8 +151,6 @@ def snapshot(disc, state) -> Snapshot:
 # ---- reading a run folder ----------------------------------------------------------------
 def stored_times(folder) -> list[tuple[float, pathlib.Path]]:
     """``(t, path)`` of the complete field files of a run folder, by time."""
-    from .series import scan_series
-
     folder = pathlib.Path(folder)
     return sorted((t, folder / name) for _, name, t in scan_series(folder) if t is not None)
 
@@ -203,12 +170,27 @@ def check_run_folder(folder) -> pathlib.Path:
     return folder
 
 
-def read_snapshot(folder, t: float | None = None, summary: dict | None = None) -> Snapshot:
-    """The stored fields of a run folder nearest to time ``t`` (default: the last).
+def damaged_files(folder) -> list[str]:
+    """The names of the field files of a run folder that are incomplete or of unknown time
+    (a run stopped while writing one, a truncated copy): they are never drawn."""
+    return [name for _, name, t in scan_series(folder) if t is None]
 
-    Raises :class:`~femehl.errors.OutputError` if the folder has no field series, or
-    ``t`` is more than half a storage interval from every stored time.  ``summary``: the
-    folder's ``summary.csv`` columns if already read (an animation reads them once).
+
+def read_snapshot(
+    folder, t: float | None = None, summary: dict | None = None, *, what: str = "fields", report: bool = True
+) -> Snapshot:
+    """The stored fields of a run folder at the stored time nearest ``t`` (default: the last).
+
+    An adaptive run stores at the times its steps reach (1.9555, 2.0339, ...): ``t`` need
+    not be one of them; the nearest is drawn and, with ``report``, the logger ``"femehl"``
+    says which (``maps at t = 2.0339 (nearest stored to 2)``).  A damaged field file (an
+    incomplete ``.vtu``) is never drawn: the last readable time is, and the warning names
+    the damaged file.  ``what`` names the picture in those reports.
+
+    Raises :class:`~femehl.errors.OutputError` if the folder has no readable field
+    series, ``t`` is outside the stored range (the message gives the range), or the
+    file to draw cannot be read.  ``summary``: the folder's ``summary.csv`` columns if
+    already read (an animation reads them once).
     """
     import meshio
 
@@ -216,7 +198,14 @@ def read_snapshot(folder, t: float | None = None, summary: dict | None = None) -
 
     folder = check_run_folder(folder)
     files = stored_times(folder)
+    damaged = damaged_files(folder)
     if not files:
+        if damaged:
+            raise OutputError(
+                f"{folder} has no readable field file: {', '.join(damaged)} "
+                f"{'is' if len(damaged) == 1 else 'are'} damaged (incomplete); rerun the case "
+                "(femehl run --overwrite) to write the fields again."
+            )
         raise OutputError(
             f"{folder} has no field series (fields_*.vtu): the run stored no fields "
             "(store_every = 0); rerun with --store-every N."
@@ -229,44 +218,59 @@ def read_snapshot(folder, t: float | None = None, summary: dict | None = None) -
             t = float(t)
         except (TypeError, ValueError):
             raise OutputError(f"t must be a number, got {t!r}.") from None
-        k = int(np.argmin(np.abs(ts - t)))
-        gap = np.min(np.diff(ts)) if ts.size > 1 else 0.0
-        if not np.isfinite(t) or abs(ts[k] - t) > max(0.5 * gap, 1e-9 * max(1.0, abs(t))):
+        eps = 1e-9 * max(1.0, abs(t)) if np.isfinite(t) else 0.0
+        if not np.isfinite(t) or t < ts[0] - eps or t > ts[-1] + eps:
             raise OutputError(
                 f"no stored fields at t = {t:g} in {folder}: the series holds "
-                f"{ts.size} time(s) from {ts[0]:g} to {ts[-1]:g}; give one of them "
-                "(or rerun with a smaller --store-every)."
+                f"{ts.size} time(s) from {ts[0]:g} to {ts[-1]:g}; give --t in that range "
+                "(the nearest stored time is drawn)."
+            )
+        k = int(np.argmin(np.abs(ts - t)))
+        if report and abs(ts[k] - t) > eps:
+            logger.info("femehl: %s at t = %.5g (nearest stored to %g)", what, ts[k], t)
+    if report and damaged:
+        number = {name: n for n, name, _ in scan_series(folder)}
+        later = [d for d in damaged if number[d] > number[files[k][1].name]]
+        if later:  # a damaged file after the one drawn: it may have been the time asked for
+            logger.warning(
+                "femehl: %s damaged (incomplete: a run stopped while writing it, or a truncated "
+                "copy) and not drawn; %s at t = %.5g from %s, the %s readable stored time",
+                ", ".join(later) + (" is" if len(later) == 1 else " are"),
+                what,
+                ts[k],
+                files[k][1].name,
+                "last" if k == ts.size - 1 else "nearest",
             )
     try:
         mesh = meshio.read(files[k][1])
     except Exception as exc:  # noqa: BLE001 - meshio raises many kinds
         raise OutputError(
-            f"cannot read {files[k][1]} ({type(exc).__name__}: {exc}); the file is damaged."
+            f"cannot read {files[k][1]} ({type(exc).__name__}: {exc}); the file is damaged: draw "
+            "another stored time (--t), or rerun the case (femehl run --overwrite)."
         ) from None
     cells = [(c.type, c.data) for c in mesh.cells]
     if "pressure" not in mesh.point_data:
         raise OutputError(f"{files[k][1]} has no pressure field: it was not written by femehl.")
     on_points = "film" in mesh.point_data
+    if not on_points and "film" not in mesh.cell_data:
+        raise OutputError(f"{files[k][1]} has no film field: it was not written by femehl.")
     film = mesh.point_data["film"] if on_points else np.concatenate(mesh.cell_data["film"])
     mirrored = _mirrored(files[k][1])
     L = float(np.max(np.hypot(mesh.points[:, 0], mesh.points[:, 1])))
     fmin = None
     where = None
     rows = read_summary(folder / "summary.csv") if summary is None else summary
-    if rows["t"].size:  # the true minimum film (nodes and origin included) from the table
+    has = all(c in rows for c in ("t", "film_min", "film_min_x", "film_min_y"))
+    if has and rows["t"].size:  # the true minimum film (nodes and origin included) from the table
         j = int(np.argmin(np.abs(rows["t"] - ts[k])))
         if abs(rows["t"][j] - ts[k]) <= 1e-9 * max(1.0, abs(ts[k])):
             fmin, where = rows["film_min"][j], (rows["film_min_x"][j], rows["film_min_y"][j])
     cav = mesh.point_data.get("cavitated")
-    from .series import field_value
-
     clipped = bool(field_value(files[k][1], "HalfSommerfeldClipped") or 0)
     p = mesh.point_data["pressure"]
     return _build(ts[k], mesh.points, cells, p, film, on_points, mirrored, L, fmin, where, cav, clipped)
 
 
 def _mirrored(path) -> bool:
-    from .series import field_value
-
     v = field_value(path, "MirroredHalfDisk")
     return bool(v) if v is not None else False

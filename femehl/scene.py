@@ -471,19 +471,12 @@ class Scene(SceneEffects):
     def _check_domain_holds_contact(self):
         """The domain must reach well past the largest contact of the run, for any indenter.
 
-        The rigid gap ``hc_min + s(x, y)`` is sampled on a polar grid out to
-        ``1.5 L`` (linear along each ray between samples); ``a_geo`` is the
-        largest radius where it is < 0 (the geometric overlap).  The rule is
-        ``L >= CONTACT_MARGIN * a_geo`` with ``CONTACT_MARGIN = 1.5/sqrt(2)``:
-        for a sphere the Hertz radius is ``a_geo/sqrt(2)``, so this is
-        ``L >= 1.5 a_Hertz``.  ``hc_min`` is the deepest clearance of the gap
-        history over ``t`` in [0, 10] (and every table time); under imposed load
-        it is the depth ``delta`` at which the dry contact carries the largest
-        |F(t)|: on a half space the Hertz law of the equivalent sphere (same
-        ``a_geo`` at depth ``delta``), ``F = (4/(3 pi)) a_geo delta / (sqrt(2) c)``
-        with ``c = 2(1 - nu)`` (exactly ``F = (4/(3 pi)) a^3`` for the unit
-        sphere, nu = 0.5); on a Winkler foundation ``F = k int (delta - s)+ dA``;
-        a rigid substrate is never indented under load (no check).
+        The rule is ``L >= CONTACT_MARGIN * a_geo`` with ``a_geo`` the largest radius
+        of the geometric overlap ``s < delta`` at the deepest indentation ``delta``
+        (for a sphere ``sqrt(2)`` times the Hertz radius, so ``L >= 1.5 a_Hertz``):
+        ``-min hc`` over ``t`` in [0, 10] (and every table time), or under an imposed
+        load the depth at which the substrate's own dry contact carries the largest
+        ``F(t)`` (:func:`femehl.substrates.contact.indentation`).
 
         Also checks that the indenter covers the domain (``check_domain(L)``
         of a height map), that its gap is one finite real value per point on
@@ -534,20 +527,7 @@ class Scene(SceneEffects):
                 "shape so that s >= 0 with s(0, 0) = 0, or start with a larger gap hc(0)."
             )
 
-        def a_geo(depth):
-            """Largest radius where -depth + s < 0 (rays interpolated linearly)."""
-            g = S - depth  # < 0: overlap
-            neg = g < 0.0
-            if not neg.any():
-                return 0.0
-            rows = np.flatnonzero(neg.any(axis=1))
-            last = nr - 1 - np.argmax(neg[rows, ::-1], axis=1)  # last negative sample
-            if np.any(last == nr - 1):
-                return math.inf  # beyond the sampled disk
-            g0, g1 = g[rows, last], g[rows, last + 1]
-            with np.errstate(all="ignore"):
-                frac = np.where(np.isfinite(g1), g0 / (g0 - g1), 1.0)
-            return float(np.max(r[last] + frac * (r[last + 1] - r[last])))
+        from .substrates.contact import indentation, sample_shape
 
         times = self._check_times()
         if self.motion.load_controlled:
@@ -569,37 +549,7 @@ class Scene(SceneEffects):
                     raise SceneError(_negative_load_message(Ft, t))
                 Fs.append(Ft)
             F = max(Fs, default=0.0)
-            kind = getattr(self.substrate, "kind", "halfspace")
-            if F == 0.0 or kind == "rigid":
-                return  # a rigid substrate is never indented
-            if kind == "winkler":
-                k = float(self.substrate.k)
-                wr = np.gradient(r) * r  # r dr (trapezoid-like)
-                wth = (math.pi if half else 2.0 * math.pi) / (th.size - (1 if half else 0))
-                wt = np.full(th.size, wth)
-                if half:
-                    wt[[0, -1]] *= 0.5
-                    wt *= 2.0  # mirror half
-
-                def F_est(depth):  # dry Winkler contact: F = k int (depth - s)+ dA
-                    return k * float(wt @ np.maximum(depth - S, 0.0) @ wr)
-            else:
-                c = float(getattr(self.substrate, "compliance", 1.0))
-
-                def F_est(depth):  # Hertz law of the equivalent sphere
-                    return (4.0 / (3.0 * math.pi)) * a_geo(depth) * depth / (math.sqrt(2.0) * c)
-
-            lo, hi = 0.0, 1.0
-            while F_est(hi) < F and math.isfinite(F_est(hi)) and hi < 1e6:
-                lo, hi = hi, 2.0 * hi
-            for _ in range(60):
-                mid = 0.5 * (lo + hi)
-                if F_est(mid) < F:
-                    lo = mid
-                else:
-                    hi = mid
-            depth = hi
-            a = a_geo(depth)
+            depth = indentation(self, load=F)[2]
             what = (
                 f"the largest imposed load |F| = {F:g} (sampled over t in [0, {times[-1]:g}]) "
                 f"presses the indenter about {depth:.3g} deep (dry-contact estimate)"
@@ -612,20 +562,17 @@ class Scene(SceneEffects):
                 except SceneError:
                     continue
             hmin = min(hs, default=hc0)
-            if hmin >= 0.0:
-                return
-            a = a_geo(-hmin)
+            depth = -hmin
             what = f"an indentation hc = {hmin:g}"
+        a = sample_shape(self).overlap_radius(depth) if depth > 0.0 else 0.0
         need = CONTACT_MARGIN * a
-        if L < need:
-            need_txt = f"{need:.3g}" if math.isfinite(need) else f"more than {CONTACT_MARGIN * rmax:.3g}"
-            a_txt = f"{a:.3g}" if math.isfinite(a) else f"more than {rmax:.3g}"
+        if L < need * (1.0 - 1e-9):  # the depth's bisection lands within 1e-15 above it
             raise SceneError(
-                f"Domain radius L = {L:g} is too small to hold the contact: {what}, which "
-                f"overlaps the rigid shape out to r = {a_txt} (a contact of radius about "
-                f"{a / math.sqrt(2.0):.3g} for a sphere), and the pressure must decay before "
-                f"r = L. Use L >= {need_txt} (the paper uses L = 2a)"
-                + (", and extend the height map to cover it." if math.isfinite(extent) else ".")
+                f"Domain radius L = {L:g} is too small to hold the contact: {what}, which the "
+                f"indenter overlaps out to r = {a:.3g} (a contact of radius about {a / math.sqrt(2.0):.3g} "
+                "for a sphere), "
+                f"and the pressure must decay before r = L. Use L >= {need:.3g} (the paper uses "
+                "L = 2a)" + (", and extend the height map to cover it." if math.isfinite(extent) else ".")
             )
 
     def _describe_indenter(self) -> str:

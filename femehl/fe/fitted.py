@@ -99,9 +99,11 @@ from femehl.fe.mesh import (
     load_mesh,
     sized_disk,
 )
+from femehl.substrates.contact import dry_contact_extent, hertz_ellipse
 
 __all__ = [
     "CACHE_DIR",
+    "hertz_ellipse",
     "FittedSizes",
     "contact_extent",
     "fitted_disk",
@@ -134,250 +136,15 @@ C_FAR = 0.152
 #: indentation still gets its tip region resolved).
 A_FLOOR = 0.05
 
-# polar sampling of the gap: rays, radial samples, Gauss points of the Sneddon integrals
-_NTH, _NR, _NPHI = 96, 801, 48
-
-
-# ---------------------------------------------------------------------------
-# contact extent
-
-
-def _run_times(f, t_end: float) -> np.ndarray:
-    """Times in [0, t_end] at which a history is sampled: a fine grid plus its knots."""
-    extra = [float(t) for t in (getattr(f, "times", ()) or ())]
-    t1 = getattr(f, "t1", None)
-    if isinstance(t1, (int, float)):
-        extra.append(float(t1))
-    extra = [t for t in extra if math.isfinite(t) and 0.0 <= t <= t_end]
-    return np.unique(np.concatenate([np.linspace(0.0, t_end, 2001), extra]))
-
-
-def _polar_gap(scene):
-    """The gap on a full polar grid: ``th (nth,)``, ``r (nr,)``, ``S (nth, nr)`` (inf where undefined)."""
-    L = scene.domain.L
-    rmax = min(1.5 * L, max(float(getattr(scene.indenter, "extent", math.inf)), L))
-    th = np.linspace(0.0, 2.0 * math.pi, _NTH, endpoint=False)
-    r = np.linspace(0.0, rmax, _NR)
-    TH, RR = np.meshgrid(th, r, indexing="ij")
-    try:
-        with np.errstate(all="ignore"):
-            S = np.asarray(scene.indenter.gap(RR * np.cos(TH), RR * np.sin(TH)), dtype=float)
-    except Exception as exc:  # noqa: BLE001 - the user's shape: name the failure
-        raise SceneError(
-            f"contact_extent: the indenter's gap(x, y) failed on r <= {rmax:g} "
-            f"({type(exc).__name__}: {exc}); fix the shape function"
-        ) from None
-    S = np.where(np.isfinite(S), S, np.inf)
-    return th, r, S
-
-
-def _overlap_radius(r, S, depth) -> np.ndarray:
-    """Per ray, the largest radius where ``s < depth`` (linear between samples; 0 if none)."""
-    g = S - depth
-    neg = g < 0.0
-    out = np.zeros(S.shape[0])
-    rows = np.flatnonzero(neg.any(axis=1))
-    if rows.size == 0:
-        return out
-    last = S.shape[1] - 1 - np.argmax(neg[rows, ::-1], axis=1)
-    if np.any(last == S.shape[1] - 1):
-        raise SceneError(
-            f"contact_extent: an indentation {depth:.3g} deep overlaps the indenter beyond the "
-            f"sampled radius {r[-1]:.3g}; use a larger domain radius L"
-        )
-    g0, g1 = g[rows, last], g[rows, last + 1]
-    with np.errstate(all="ignore"):
-        frac = np.where(np.isfinite(g1), g0 / (g0 - g1), 1.0)
-    out[rows] = r[last] + frac * (r[last + 1] - r[last])
-    return out
-
-
-def _axes_of(th, radius) -> tuple[float, float]:
-    return float(np.max(np.abs(radius * np.cos(th)))), float(np.max(np.abs(radius * np.sin(th))))
-
-
-class _RaySneddon:
-    """Sneddon's axisymmetric contact, applied ray by ray to the profile ``f(r) = s(r, theta)``.
-
-    For an axisymmetric profile on a half space the contact radius ``c`` at depth
-    ``delta`` solves ``delta = c int_0^{pi/2} f'(c sin phi) dphi`` and the load is
-    ``F = (2 / (pi cc)) c^2 int_0^{pi/2} sin^2 phi f'(c sin phi) dphi`` in femehl's
-    units (``cc = 2 (1 - nu)``; for the unit sphere ``c = sqrt(delta)``,
-    ``F = 4 c^3 / (3 pi cc)``, design.md section 2).  Exact for every axisymmetric
-    indenter (Sphere, FlatPunch); for other shapes each ray is treated as if the
-    indenter were the body of revolution of that ray's profile (a heuristic: the
-    contact of an elliptic paraboloid is less eccentric than this gives).
-    """
-
-    def __init__(self, r, S, cc):
-        self.r, self.cc = r, cc
-        fp = np.gradient(np.where(np.isfinite(S), S, np.nan), r, axis=1)
-        self.fp = np.nan_to_num(fp, nan=0.0, posinf=0.0, neginf=0.0)
-        x, w = np.polynomial.legendre.leggauss(_NPHI)
-        self.phi = 0.25 * math.pi * (x + 1.0)
-        self.w = 0.25 * math.pi * w
-        dr = r[1] - r[0]
-        idx = r[:, None] * np.sin(self.phi)[None, :] / dr  # (nc, nphi) fractional indices
-        i0 = np.minimum(idx.astype(int), r.size - 2)
-        f = idx - i0
-        vals = self.fp[:, i0] * (1.0 - f) + self.fp[:, i0 + 1] * f  # (nth, nc, nphi)
-        self.depth = r[None, :] * (vals @ self.w)  # delta(c) per ray
-        self.load = (2.0 / (math.pi * cc)) * r[None, :] ** 2 * (vals @ (self.w * np.sin(self.phi) ** 2))
-
-    def radius(self, delta) -> np.ndarray:
-        """Per ray, the first contact radius ``c`` with ``delta(c) >= delta``."""
-        D = self.depth
-        hit = D >= delta
-        if not hit.any(axis=1).all():
-            raise SceneError(
-                f"contact_extent: an indentation {delta:.3g} deep spreads the contact beyond the "
-                f"sampled radius {self.r[-1]:.3g}; use a larger domain radius L"
-            )
-        k = np.argmax(hit, axis=1)
-        k0 = np.maximum(k - 1, 0)
-        rows = np.arange(D.shape[0])
-        d0, d1 = D[rows, k0], D[rows, k]
-        with np.errstate(all="ignore"):
-            frac = np.where(d1 > d0, (delta - d0) / (d1 - d0), 1.0)
-        return self.r[k0] + np.clip(frac, 0.0, 1.0) * (self.r[k] - self.r[k0])
-
-    def force(self, delta) -> float:
-        """Ray-averaged Sneddon load at depth ``delta``."""
-        c = self.radius(delta)
-        F = [np.interp(ci, self.r, row) for ci, row in zip(c, self.load, strict=True)]
-        return float(np.mean(F))
-
-
-def hertz_ellipse(Rx: float, Ry: float, delta: float) -> tuple[float, float, float]:
-    """Hertz contact of the elliptic paraboloid ``x^2/(2 Rx) + y^2/(2 Ry)`` pressed ``delta`` deep.
-
-    Returns ``(ax, ay, m)``: the semi-axes along x and y and ``m = e^2 = 1 -
-    (short/long)^2``.  With curvatures ``A <= B`` (``A`` along the long axis),
-    ``B/A = (E(m)/(1 - m) - K(m)) / (K(m) - E(m))`` fixes ``m`` and
-    ``a_long^2 = delta (K - E) / (A K m)`` (Johnson, Contact Mechanics, section 3.5,
-    with ``delta = cc pi b p0 K`` in femehl's units); a sphere (``m -> 0``) gives
-    ``a = sqrt(R delta)``.  Independent of the substrate's compliance.
-    """
-    from scipy.optimize import brentq
-    from scipy.special import ellipe, ellipk
-
-    A, B = 1.0 / (2.0 * Rx), 1.0 / (2.0 * Ry)
-    lo, hi = min(A, B), max(A, B)
-    q = hi / lo
-    if q < 1.0 + 1e-9:
-        a = math.sqrt(delta / (2.0 * lo))
-        return a, a, 0.0
-
-    def f(m):
-        K, E = ellipk(m), ellipe(m)
-        return (E / (1.0 - m) - K) / (K - E) - q
-
-    m = brentq(f, 1e-12, 1.0 - 1e-15, xtol=1e-15)
-    K, E = ellipk(m), ellipe(m)
-    a = math.sqrt(delta * (K - E) / (lo * K * m))
-    b = a * math.sqrt(1.0 - m)
-    return ((a, b) if A < B else (b, a)) + (float(m),)
-
-
-def _hertz_ellipse_load(Rx, Ry, delta, cc) -> float:
-    """Hertz load ``F = (2/3) a_long delta / (cc K(m))`` (unit sphere: ``4 delta^(3/2) / (3 pi cc)``)."""
-    from scipy.special import ellipk
-
-    ax, ay = hertz_ellipse(Rx, Ry, delta)[:2]
-    along = max(ax, ay)
-    m = 1.0 - (min(ax, ay) / along) ** 2
-    return (2.0 / 3.0) * along * delta / (cc * float(ellipk(m)))
-
-
-def _invert(F_of, F, what) -> float:
-    """Depth ``delta`` with ``F_of(delta) = F`` (monotone), by doubling then bisection."""
-    lo, hi = 0.0, 1e-3
-    while F_of(hi) < F:
-        lo, hi = hi, 2.0 * hi
-        if hi > 1e6:
-            raise SceneError(f"contact_extent: {what} cannot carry the load {F:g}; check the load history")
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if F_of(mid) < F else (lo, mid)
-    return hi
-
 
 def contact_extent(scene, t_end: float) -> tuple[float, float]:
-    """The largest dry-contact semi-axes ``(ax, ay)`` along x and y over a run to ``t_end``.
-
-    The deepest indentation of the run is ``delta = -min hc(t)`` (imposed gap;
-    ``t`` sampled on 2001 points of ``[0, t_end]`` plus the history's knots), or
-    under an imposed load the depth at which the *dry* contact carries the
-    largest ``F(t)`` (the film only adds a thin layer).  The contact at that depth:
-
-    * half space, a paraboloid (an indenter with ``curvature_radii()``: Sphere,
-      Ellipsoid): Hertz (:func:`hertz_ellipse`; sphere ``a = sqrt(R delta)``,
-      ``F = 4 a^3/(3 pi cc)``);
-    * half space, any other shape: Sneddon's axisymmetric solution ray by ray
-      (:class:`_RaySneddon`; exact for FlatPunch; a heuristic for a shape
-      without axial symmetry), load the ray average;
-    * Winkler or rigid: the geometric overlap ``hc + s < 0`` (a Winkler
-      foundation has no lateral spreading); Winkler load ``F = k int (delta - s)+ dA``;
-      a rigid substrate is never indented under load: ``(0, 0)``.
-
-    The shape is sampled on a polar grid (96 rays, 801 radii out to
-    ``min(1.5 L, map extent)``) as ``Scene._check_domain_holds_contact`` does.
-
-    Returns
-    -------
-    (float, float)
-        ``(0.0, 0.0)`` if the indenter never touches (``hc >= 0`` throughout or
-        zero load).
-
-    Raises
-    ------
-    SceneError
-        If ``t_end`` is not positive, or the contact spreads beyond the sampled disk.
+    """The largest dry-contact semi-axes ``(ax, ay)`` along x and y over a run to ``t_end``:
+    :func:`femehl.substrates.contact.dry_contact_extent` on the run's times (2001 points of
+    ``[0, t_end]`` plus the history's knots); ``(0.0, 0.0)`` if the indenter never touches.
     """
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
         raise SceneError(f"contact_extent: t_end = {t_end!r} must be a positive finite time")
-    motion, sub, ind = scene.motion, scene.substrate, scene.indenter
-    kind = getattr(sub, "kind", "halfspace")
-    cc = float(getattr(sub, "compliance", 1.0))
-    radii = getattr(ind, "curvature_radii", None)  # a paraboloid: Sphere, Ellipsoid
-    th, r, S = _polar_gap(scene)
-    if kind == "halfspace" and callable(radii):
-        Rx, Ry = (float(v) for v in radii())
-
-        def axes(delta):
-            return hertz_ellipse(Rx, Ry, delta)[:2]
-
-        def F_of(delta):
-            return _hertz_ellipse_load(Rx, Ry, delta, cc)
-    elif kind == "halfspace":
-        rs = _RaySneddon(r, S, cc)
-
-        def axes(delta):
-            return _axes_of(th, rs.radius(delta))
-
-        F_of = rs.force
-    else:
-
-        def axes(delta):
-            return _axes_of(th, _overlap_radius(r, S, delta))
-
-        k = float(getattr(sub, "k", 0.0))
-        area = (r[1] - r[0]) * r * (2.0 * math.pi / th.size)  # dA of a sample on each ray
-
-        def F_of(delta):
-            return k * float(np.sum(np.maximum(delta - S, 0.0) @ area))
-
-    if motion.load_controlled:
-        F = max(motion.F(float(t)) for t in _run_times(motion.load, t_end))
-        if F <= 0.0 or kind == "rigid":
-            return 0.0, 0.0
-        delta = _invert(F_of, F, f"the {kind} substrate")
-    else:
-        delta = -min(motion.hc(float(t)) for t in _run_times(motion.gap, t_end))
-        if delta <= 0.0:
-            return 0.0, 0.0
-    ax, ay = axes(delta)
-    return float(ax), float(ay)
+    return dry_contact_extent(scene, t_end)[:2]
 
 
 # ---------------------------------------------------------------------------

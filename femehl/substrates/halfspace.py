@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from ..errors import SceneError
 from ..validation import check_finite
 from .base import register_substrate
+from .contact import elastic_contact
 
 __all__ = ["HalfSpace"]
 
@@ -43,3 +44,7 @@ class HalfSpace:
 
     def deflection_rows(self, disc, points):
         return self.compliance * disc.boussinesq_rows(points)
+
+    def dry_contact(self, shape):
+        """Hertz / Sneddon (:func:`femehl.substrates.contact.elastic_contact`)."""
+        return elastic_contact(shape, self.compliance)

@@ -23,9 +23,8 @@ The operator (FE and FD): the exact ``1/r`` integral of the discretized pressure
 each element minus the integral of ``R`` (:meth:`femehl.discretizations.fe_disk.FEDisc.radial_kernel`):
 sparse for a thin layer (pairs beyond the cut-off are zero), dense otherwise.  The fast
 hierarchical operator (``operator="fast"``) is the half space's only; line contact takes
-local substrates only.  Under an imposed load the scene's check that the domain holds the
-contact uses the half space's dry-contact estimate (``compliance``): the layer is stiffer,
-so the check is conservative.
+local substrates only.  Its dry contact (:meth:`Layer.dry_contact`) bounds depth and
+extent from the half space and the geometric overlap.
 """
 
 from __future__ import annotations
@@ -37,6 +36,7 @@ import numpy as np
 from ..errors import SceneError
 from ..validation import check_finite, check_positive
 from .base import register_substrate
+from .contact import DryContact, elastic_contact
 
 __all__ = ["Layer"]
 
@@ -107,3 +107,11 @@ class Layer:
 
     def deflection_rows(self, disc, points):
         return self._primitive(disc, "radial_kernel_rows")(self.kernel, points) * self.compliance
+
+    def dry_contact(self, shape):
+        """Bounds that hold at any thickness: a layer is stiffer than the half space of its
+        ``compliance`` (so that half space's depth under a load is the deeper) and spreads
+        less than the geometric overlap (its thin limit): depth from the half space, extent
+        from the overlap."""
+        half = elastic_contact(shape, self.compliance, "the layer")
+        return DryContact(shape.overlap_axes, half.load, "the layer")

@@ -8,6 +8,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .base import register_substrate
+from .contact import overlap_contact
 
 __all__ = ["Rigid"]
 
@@ -26,3 +27,7 @@ class Rigid:
 
     def deflection_rows(self, disc, points):
         return sp.csr_matrix((np.asarray(points).reshape(-1, 2).shape[0], disc.n))
+
+    def dry_contact(self, shape):
+        """Never indented under a load; an imposed gap overlaps the shape geometrically."""
+        return overlap_contact(shape, None, "a rigid substrate")

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ..validation import check_positive
 from .base import register_substrate
+from .contact import overlap_contact
 
 __all__ = ["Winkler"]
 
@@ -28,3 +29,7 @@ class Winkler:
 
     def deflection_rows(self, disc, points):
         return (disc.pressure_rows(points) / self.k).tocsr()
+
+    def dry_contact(self, shape):
+        """The geometric overlap, ``F = k int (delta - s)+ dA`` (no lateral spreading)."""
+        return overlap_contact(shape, self.k, "the Winkler foundation")

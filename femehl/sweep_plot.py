@@ -46,6 +46,12 @@ def steady_table(out):
 
     out = pathlib.Path(out)
     df = read_results(out)
+    missing = sorted({"case", "status", "t", *(q for q, _ in QUANTITIES)} - set(df.columns))
+    if missing:
+        raise OutputError(
+            f"{out}/results.parquet has no column(s) {', '.join(missing)}: it is damaged or not a "
+            "femehl sweep's table; rerun the sweep (femehl sweep SWEEP.toml) to rewrite it from the cases."
+        )
     done = df[(df["status"] == "done") & np.isfinite(df["t"])]
     last = done.sort_values("t").groupby("case", sort=False).tail(1).copy()
     scenes = {}
@@ -82,6 +88,10 @@ def plot_master_curves(out, x: str | None = None):
     from .output.plots import _save
 
     out = pathlib.Path(out)
+    if not out.is_dir():
+        raise OutputError(
+            f"{out} is not a folder: give the output folder of a sweep (its [sweep] out, or --out)."
+        )
     last, df = steady_table(out)
     names = _swept(out)
     numeric = [n for n in names if n in last and _numeric(last[n])]
@@ -249,4 +259,7 @@ def _write_md(path, x, rows, lines):
         up = "" if not np.isfinite(n_up) else f"{n_up:.3f}"
         out.append(f"| {label or '-'} | {q} | {n_all:.3f} | {up} | {k} |")
     out += ["", "```", *lines, "```", ""]
-    pathlib.Path(path).write_text("\n".join(out))
+    from .output._files import write_atomic
+
+    text = "\n".join(out)
+    write_atomic(path, lambda tmp: tmp.write_text(text), "write the fitted exponents")

@@ -832,9 +832,12 @@ def sweep(
     if todo:
         client, cluster = _client(scheduler, workers, memory_limit)
         try:
+            # the task key names the folder too: two sweeps sharing a case on one scheduler
+            # each get their own task (never the record of another folder)
+            where = hashlib.sha256(str(plan.out.resolve()).encode()).hexdigest()[:8]
             futures = {
                 client.submit(
-                    runner, c, str(plan.out / "cases" / c.key), key=f"femehl-case-{c.key}", pure=False
+                    runner, c, str(plan.out / "cases" / c.key), key=f"femehl-case-{c.key}-{where}", pure=False
                 ): c
                 for c in todo
             }

@@ -243,7 +243,7 @@ def read_snapshot(
             )
     try:
         mesh = meshio.read(files[k][1])
-    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many kinds, and exits on some
         raise OutputError(
             f"cannot read {files[k][1]} ({type(exc).__name__}: {exc}); the file is damaged: draw "
             "another stored time (--t), or rerun the case (femehl run --overwrite)."

@@ -68,7 +68,10 @@ Steps never cross a breakpoint of the motion (:attr:`femehl.scene.Motion.breakpo
 the end of the indentation ramp, the start of sliding, table times): a step lands
 exactly on it, and since the derivatives of the solution jump there the history is
 dropped (``d_prev = None``: the next step is a backward-Euler start again) and the step
-restarts from ``min(dt, dt0)``.  A resumed run (``start``) restarts the same way.
+restarts from ``min(dt, dt0)``.  A resumed run (``start``) restarts the same way.  On a
+substrate whose pressure follows the motion at once (``substrate.instant``: a rigid one,
+where p is algebraic in hc'), the load jumps at such a (re)start: that jump is no time
+error, so the load is judged from the levels after it only (the film from all of them).
 
 Failures
 --------
@@ -167,6 +170,10 @@ class _Run:
     rejected_total: int = 0
     dt_low: float = math.inf
     dt_high: float = 0.0
+    #: the substrate's pressure follows the motion at once (``substrate.instant``: rigid):
+    #: the load jumps at the (re)start ``origin`` where hc' does, which is no time error
+    instant: bool = False
+    origin: float = -math.inf
 
 
 @dataclass(frozen=True)
@@ -211,10 +218,13 @@ def _lagrange(ts, t) -> np.ndarray:
     return w
 
 
-def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float) -> float:
-    """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (see the module doc)."""
+def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) -> float:
+    """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (see the module doc);
+    the film alone when ``load_pred`` is None."""
     d = np.asarray(trial.d, dtype=float)
     err = float(np.max(np.abs(d - d_pred) / d)) if d.size else 0.0
+    if load_pred is None:
+        return err
     load = _load(trial)
     scale = max(run.load_scale, abs(load), LOAD_FLOOR)
     return max(err, abs(load - load_pred) / scale)
@@ -226,9 +236,16 @@ def _load(state: State) -> float:
     return float((state.info or {}).get("load_full", state.load))
 
 
-def _predict(levels, t):
+def _predict(run: _Run, levels, t):
+    """The film and load extrapolated to ``t``; the load of an instant substrate from the
+    levels after its (re)start only (linear from two, None from fewer)."""
     w = _lagrange([s.t for s in levels], t)
     d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels, strict=True))
+    if run.instant:
+        levels = [s for s in levels if s.t > run.origin]
+        if len(levels) < 2:
+            return d_pred, None
+        w = _lagrange([s.t for s in levels], t)
     load_pred = float(sum(wi * _load(s) for wi, s in zip(w, levels, strict=True)))
     return d_pred, load_pred
 
@@ -245,14 +262,15 @@ def _milne(run: _Run, trial: State, order: int) -> float:
         om = h / h1
         hb = h * (1.0 + om) / (1.0 + 2.0 * om)
         c = hb / (hb + h + h1 + h2)
-    return c * _norm(run, trial, *_predict(levels, trial.t)) / max(h, UNIT_STEP)
+    return c * _norm(run, trial, *_predict(run, levels, trial.t)) / max(h, UNIT_STEP)
 
 
 def _start_error(run: _Run, trial: State) -> float:
     """The error of the Euler start step from the second difference of ``d0, d1, d2``."""
     s0, s1 = run.levels[0], run.levels[1]
     h1, h2 = s1.t - s0.t, trial.t - s1.t
-    return h1 * h1 / (h2 * (h1 + h2)) * _norm(run, trial, *_predict([s0, s1], trial.t)) / max(h1, UNIT_STEP)
+    err = _norm(run, trial, *_predict(run, [s0, s1], trial.t))
+    return h1 * h1 / (h2 * (h1 + h2)) * err / max(h1, UNIT_STEP)
 
 
 def _next_h(dt: float, remaining: float) -> float:
@@ -354,14 +372,17 @@ def _floor_error(
     return exc
 
 
-def _limits(t_span, tol, dt0, dt_min, dt_max):
+def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf):
     dt_max = t_span / 10.0 if dt_max is None else check_positive("dt_max", dt_max)
+    dt_max = min(dt_max, limit)  # the substrate's model resolves no longer step (its memory)
     # the floor stays 100 times below the first step (a long run at a small tol starts
     # with steps ~0.05 tol, below 1e-6 of its span)
-    dt_min = min(1e-6 * t_span, 5e-4 * tol) if dt_min is None else check_positive("dt_min", dt_min)
+    dt_min = min(1e-6 * t_span, 5e-4 * tol, dt_max) if dt_min is None else check_positive("dt_min", dt_min)
     if dt0 is None:
         dt0 = max(dt_min, min(dt_max, 0.05 * tol))
     dt0 = check_positive("dt0", dt0)
+    if dt0 > dt_max == limit:  # a first step given beyond what the substrate resolves
+        dt0 = max(dt_min, dt_max)
     if not dt_min <= dt0 <= dt_max:
         raise SceneError(f"need dt_min <= dt0 <= dt_max, got {dt_min:g}, {dt0:g}, {dt_max:g}.")
     return dt0, dt_min, dt_max
@@ -394,7 +415,9 @@ def march_adaptive(
         First step and the step after each breakpoint; default ``0.05 tol``.
     dt_min, dt_max : float, optional
         Step floor and ceiling; default ``min(1e-6 span, 5e-4 tol)`` (100 times below
-        the default first step) and ``0.1`` times the run's span.
+        the default first step) and ``0.1`` times the run's span.  The ceiling is at most
+        the substrate's ``step_limit`` (:func:`femehl.substrates.base.step_limit`: the
+        largest step a viscoelastic memory resolves).
     start : State, optional
         Continue from this state (its history is dropped: the run restarts there).
     safety : float, default: 0.9
@@ -410,7 +433,11 @@ def march_adaptive(
     state = stepper.initial_state() if start is None else start
     if t_end <= state.t:
         raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
-    dt0, dt_min, dt_max = _limits(t_end - state.t, tol, dt0, dt_min, dt_max)
+    from ..substrates.base import step_limit
+
+    scene = getattr(stepper, "scene", None)
+    limit = step_limit(getattr(scene, "substrate", None), scene, getattr(stepper, "disc", None), t_end)
+    dt0, dt_min, dt_max = _limits(t_end - state.t, tol, dt0, dt_min, dt_max, limit)
     eps = 1e-12 * max(1.0, abs(t_end))
     stops = sorted(
         {b for b in breakpoints_of(getattr(stepper, "scene", None)) if state.t + eps < b < t_end - eps}
@@ -420,7 +447,14 @@ def march_adaptive(
     order = _order(stepper)
 
     state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
-    run = _Run(dt=dt0, levels=[_restart(state)], load_scale=abs(_load(state)), film0=film_floor(state)[0])
+    run = _Run(
+        dt=dt0,
+        levels=[_restart(state)],
+        load_scale=abs(_load(state)),
+        film0=film_floor(state)[0],
+        instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
+        origin=state.t,
+    )
     run.recent.append(state)
     yield state
     for stop in stops:
@@ -430,6 +464,7 @@ def march_adaptive(
             yield from _emit(run, run.pending, run.pending_rejected, math.nan)
         if stop < t_end:  # a breakpoint: the derivatives jump, restart
             run.levels = [_restart(run.levels[-1])]
+            run.origin = run.levels[0].t
             run.dt = min(run.dt, dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
     logger.info(

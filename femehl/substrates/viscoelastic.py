@@ -66,6 +66,7 @@ stays 0).  Under a constant load in the dry limit the Hertz contact radius creep
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -186,6 +187,31 @@ class Viscoelastic:
     def deflection_rows(self, disc, points):
         return self.elastic.deflection_rows(disc, points)
 
+    #: the material crosses the film domain in at least this many adaptive steps
+    TRANSIT_STEPS = 4
+
+    def step_limit(self, scene, disc, t_end: float) -> float:
+        """The largest step the memory's integrator resolves: the sliding material crosses
+        the film domain (its extent along x) in at least :attr:`TRANSIT_STEPS` steps at the
+        largest speed of the run, ``span / (2 V_max TRANSIT_STEPS)``; math.inf without sliding.
+
+        Each step integrates the memory exactly along the characteristic for a source frozen
+        in time and takes the source's increment over the step at the arrival point: exact
+        in a steady state whatever dt, second order in a transient while the step's shift
+        ``2 V dt`` is a fraction of the length over which the source varies (the contact).
+        Beyond that the memory of the whole domain is rebuilt each step from the previous
+        step's source, an error the adaptive steps' film-based estimate does not scale with;
+        a quarter of the domain keeps it a fraction of the contact for L >= 2 a.
+        """
+        pts = np.asarray(disc.film_points, dtype=float)
+        span = float(np.ptp(pts[:, 0])) if pts.size else 0.0
+        motion = getattr(scene, "motion", None)
+        if motion is None or span <= 0.0:
+            return math.inf
+        ts = np.union1d(np.linspace(0.0, float(t_end), 2001), getattr(motion, "breakpoints", ()) or ())
+        v = max(abs(float(motion.V(t))) for t in ts[(ts >= 0.0) & (ts <= t_end)])
+        return math.inf if v == 0.0 else span / (2.0 * v * self.TRANSIT_STEPS)
+
     def memory(self, disc) -> CreepMemory:
         """The internal variable's integrator on ``disc`` (used by the stepper)."""
         return CreepMemory(self, disc)
@@ -196,53 +222,77 @@ class StepMemory:
     """One step's viscoelastic response: ``w = -(scale u + offset)`` with ``u = C p``.
 
     ``offset`` lives on the film points; :meth:`offset_at` gives it elsewhere (the origin,
-    probed nodes); :meth:`creep` is the internal variable after the step (on the memory's
-    grid).
+    probed nodes); :meth:`creep` is the internal variable's state after the step.
     """
 
     scale: float
     offset: np.ndarray
-    weight: float  # (dt/tau_c) (J_inf - J0) / (a0 + dt/tau_c): q^{k+1} = offset + weight u
+    weight: float  # q^{k+1} = offset + weight u^{k+1}
     grid_offset: np.ndarray
     _at: object
     _to_grid: object
-    _film: object
+    _state: object
 
     def offset_at(self, points):
         return self._at(points)
 
     def creep(self, u):
-        """The internal variable after the step (the state's ``creep`` array: grid values,
-        then the film points' defects) from ``u^{k+1} = C p^{k+1}`` on the film points."""
+        """The internal variable's state after the step (the state's ``creep`` array, see
+        :meth:`CreepMemory.split`) from ``u^{k+1} = C p^{k+1}`` on the film points."""
         u = np.asarray(u, dtype=float)
-        grid = self.grid_offset + self.weight * np.asarray(self._to_grid @ u).ravel()
-        return self._film(grid, self.offset + self.weight * u)
+        ug = np.asarray(self._to_grid @ u).ravel()
+        return self._state(self.grid_offset + self.weight * ug, self.offset + self.weight * u, ug, u)
+
+
+def _phi(r):
+    """``(a, b) = (int_0^1 r e^{-r s} (1 - s) ds, int_0^1 r e^{-r s} s ds)``: the exact
+    weights of a source linear in s over an interval of r relaxation times (a + b = 1 - e^{-r})."""
+    r = np.asarray(r, dtype=float)
+    small = r < 1e-4
+    rs = np.where(small, 1.0, r)
+    b = np.where(small, r / 2 - r * r / 3 + r**3 / 8, (-np.expm1(-rs) - rs * np.exp(-rs)) / rs)
+    return -np.expm1(-r) - b, b
 
 
 class CreepMemory:
-    """Semi-Lagrangian integrator of ``tau_c Dq/Dt = (J_inf - J0) u - q`` on a discretization.
+    """Exponential integrator of ``tau_c Dq/Dt = (J_inf - J0) u - q`` along the characteristics.
 
-    The internal variable lives on a uniform grid aligned with the sliding direction
-    (spacing that of the film points in the finest part of the mesh -- the 5th
+    State.  The internal variable lives on a uniform grid aligned with the sliding
+    direction (spacing that of the film points in the finest part of the mesh -- the 5th
     percentile of nearest-neighbour distances --, at most :data:`MAX_COLUMNS` columns;
-    twice that across, where nothing is transported), where the
-    transport along x is a cubic-spline shift (error O(dx^4) per step: no numerical
-    diffusion to speak of).  The step's source ``u = C p`` reaches the grid by linear
-    interpolation from the film points (a Delaunay triangulation of them, mirrored for a
-    half disk; an O(h^2) error that does not accumulate, since the grid keeps the master
-    copy), and the grid's history reaches the film points, the origin and the nodes by
-    the same cubic spline.  Beyond the grid (material entering upstream) the spline takes
-    the edge value (mode "nearest").  The film points also keep their *defect*, their own value
-    minus the grid's spline there (an O(h^2) round-trip error), kept in place (not shifted:
-    carrying it by repeated linear interpolation went unstable near the rim with BDF2): at
-    zero shift the history at a film point is then its own value exactly, so a step of any
-    size continues the film points' memory without a jump (the adaptive step controller,
-    which tests the film points, would otherwise meet an error floor that no step size
-    removes).  The price is a larger transport error: 0.90 % instead of 0.52 % in the test
-    case (medium mesh).  The origin and the nodes take the grid's value.
+    twice that across, where nothing is transported); the state also keeps the source
+    ``u = C p`` of the last step on the grid and on the film points, and the film points'
+    *defect* (their own q minus the grid's cubic spline there: an O(h^2) round trip,
+    kept so that a step of any size continues the film points' memory without a jump).
+
+    Step (exact along the characteristic, for any dt).  The material at ``x`` at
+    ``t_{k+1}`` was at ``x + sigma(theta)`` a time ``theta`` earlier, ``sigma = 2 int V``
+    (V linear over the step).  With the source linear in time between ``u^k`` (on the
+    path) and ``u^{k+1}`` (its increment taken at the arrival point ``x``: an
+    ``O(dt^2 V du/dx)`` error, second order, zero in a steady state),
+
+        q^{k+1}(x) = e^{-r} q^k(x + s) + (dJ/tau_c) int_0^dt e^{-theta/tau_c} u^k(x + sigma) dtheta
+                     + w [u^{k+1}(x) - u^k(x)],       r = dt/tau_c,  s = sigma(dt),
+        w = dJ int_0^1 r e^{-r s} (1 - s) ds      (-> dJ r/2 for small r, dJ for large r),
+
+    affine in the step's own ``u^{k+1}``: the step's film is ``d = h + offset + J_eff C p``
+    with ``J_eff = J0 + w``, ONE linear system (the stepper's).  The integral is a
+    quadrature on sub-steps that shift the material by at most one grid spacing (``u^k``
+    by the grid's cubic spline, linear in between, exact exponential weights), so the
+    spatial integration is the grid's, not the step's: in a steady state
+    (``u^{k+1} = u^k``, ``q^{k+1} = q^k``) this is the exact characteristic relation of
+    the steady memory for every ``dt``, and the steady state does not depend on dt.
+    Material (and source) beyond the grid's upstream edge has no creep: q = 0 and u = 0
+    there (it has not been loaded yet; exact for a Winkler foundation, whose deflection
+    vanishes at the rim), reached linearly over one grid spacing beyond the edge (so a
+    step continues the memory without a jump however small its shift).  Points beyond
+    the grid at zero shift (the rim nodes) take the edge value.  The film points' defect follows the material out over one grid spacing
+    of travel (factor ``e^{-|s|/dx}``: kept at rest, forgotten once its material is gone).
     """
 
     MAX_COLUMNS = 4096
+    #: at most this many sub-steps of the source's quadrature along a path
+    MAX_SUBSTEPS = 100_000
 
     def __init__(self, solid: Viscoelastic, disc):
         from scipy.spatial import Delaunay, cKDTree
@@ -311,15 +361,20 @@ class CreepMemory:
 
     @property
     def size(self) -> int:
-        """Length of the internal variable's state: the grid values, then the film points'
-        defects (see :meth:`step`)."""
-        return self.grid.shape[0] + self.points.shape[0]
+        """Length of the internal variable's state (see :meth:`split`)."""
+        return 2 * (self.grid.shape[0] + self.points.shape[0])
 
     def split(self, state_array):
-        """``(grid values, film-point defects)`` of a state's ``creep`` array."""
+        """``(q on the grid, film points' defects, u on the grid, u on the film points)`` of
+        a state's ``creep`` array (u: the last step's source ``C p``)."""
         a = np.asarray(state_array, dtype=float)
-        m = self.grid.shape[0]
-        return a[:m], a[m:]
+        m, n = self.grid.shape[0], self.points.shape[0]
+        return a[:m], a[m : m + n], a[m + n : 2 * m + n], a[2 * m + n :]
+
+    def _state(self, q, q_film, u, u_film):
+        """The state array: grid values, the film points' defects, the source."""
+        defect = q_film - self._eval(self._spline(q), self.points, 0.0)
+        return np.concatenate([q, defect, u, u_film])
 
     # ---- the cubic spline of a grid field -------------------------------------------------
     def _spline(self, q):
@@ -328,57 +383,84 @@ class CreepMemory:
         Q = np.asarray(q, dtype=float).reshape(self.shape)
         return spline_filter(Q[0] if self.one_d else Q, order=3, mode="nearest")
 
+    def _columns(self, points, shift):
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return pts, (pts[:, 0] + shift - self.x0) / self.dx
+
     def _eval(self, coef, points, shift):
+        """The grid field at ``points + (shift, 0)``; 0 where the shift leaves the grid by
+        more than a grid spacing (material not yet in the domain: no creep), linear in
+        between (so continuous in the shift), the edge value at zero shift."""
         from scipy.ndimage import map_coordinates
 
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        col = (pts[:, 0] + shift - self.x0) / self.dx
+        pts, col = self._columns(points, shift)
         if self.one_d:
             coords = col[None, :]
         else:
             y = np.abs(pts[:, 1]) if self.half else pts[:, 1]
             coords = np.vstack([(y - self.y0) / self.dy, col])
-        return map_coordinates(coef, coords, order=3, mode="nearest", prefilter=False)
+        out = map_coordinates(coef, coords, order=3, mode="nearest", prefilter=False)
+        if shift != 0.0:  # beyond the upstream edge: down to 0 over one grid spacing of travel
+            edge = self.shape[1] - 1.0
+            start = col - shift / self.dx
+            beyond = col - np.maximum(edge, start) if shift > 0.0 else np.minimum(0.0, start) - col
+            out *= np.clip(1.0 - beyond, 0.0, 1.0)
+        return out
+
+    def _path(self, dt, V0, V1):
+        """Sub-step shifts ``sigma_j`` (a time ``theta_j = j dt/M`` before arrival) and the
+        exact weights ``W_j`` of a source linear between them (sum: dJ (1 - e^{-dt/tau_c}))."""
+        tc = self.solid.tau_creep
+        dJ = self.solid.J_inf - self.solid.J0
+        s = dt * (V0 + V1)
+        m = int(min(self.MAX_SUBSTEPS, max(1, np.ceil(abs(s) / self.dx))))
+        th = dt * np.arange(m + 1) / m
+        sig = 2.0 * (V1 * th + (V0 - V1) * th * th / (2.0 * dt))
+        a, b = _phi(dt / m / tc)
+        decay = np.exp(-th / tc)
+        W = np.zeros(m + 1)
+        W[:-1] += a * decay[:-1]
+        W[1:] += b * decay[:-1]
+        keep = np.abs(sig) <= (self.shape[1] + 1) * self.dx  # beyond: no source there
+        return sig[keep], dJ * W[keep]
 
     # ---- one step -----------------------------------------------------------------------
-    def step(self, state, t_new: float, dt: float, a0: float, a1: float, a2: float, V) -> StepMemory:
+    def step(self, state, t_new: float, dt: float, a0=None, a1=None, a2=None, V=None) -> StepMemory:
         """The step's scale and offset from the material's history (``state.creep``).
 
-        ``a0, a1, a2`` are the step's backward-difference coefficients; without the
-        internal variable one step back (a restart without history) the step is Euler's.
+        Exact along the characteristic whatever the step (class docstring): the stepper's
+        backward-difference coefficients ``a0, a1, a2`` are not used.
         """
         solid = self.solid
-        q, e = self.split(np.zeros(self.size) if state.creep is None else state.creep)
-        qp, ep = self.split(state.creep_prev) if state.creep_prev is not None else (None, None)
-        t = state.t
-        s1 = dt * (V(t) + V(t_new))  # 2 int V dt over the step, trapezoidal
-        two = a2 != 0.0 and qp is not None and bool(state.dt_prev)
-        if two:
-            s2 = s1 + state.dt_prev * (V(t - state.dt_prev) + V(t))
-        else:
-            a0, a1, a2, s2 = 1.0, 1.0, 0.0, 0.0
+        q, e, ug, uf = self.split(np.zeros(self.size) if state.creep is None else state.creep)
+        V0, V1 = float(V(state.t)), float(V(t_new))
+        s = dt * (V0 + V1)  # 2 int V dt over the step
         r = dt / solid.tau_creep
-        den = a0 + r
-        dJ = solid.J_inf - solid.J0
-        c1 = self._spline(q)
-        c2 = self._spline(qp) if two else None
+        decay = np.exp(-r)
+        w = (solid.J_inf - solid.J0) * float(_phi(r)[0])
+        sig, W = self._path(dt, V0, V1)
+        cq, cu = self._spline(q), self._spline(ug)
+        keep_defect = decay * np.exp(-abs(s) / self.dx)
 
-        def history(points, e1=0.0, e2=0.0):
-            out = a1 * (self._eval(c1, points, s1) + e1)
-            return (out - a2 * (self._eval(c2, points, s2) + e2) if two else out) / den
+        def offset(points, film=False):
+            out = decay * self._eval(cq, points, s)
+            if film:  # the film points: their own u^k and defect at the arrival point
+                u0 = self._eval(cu, points, 0.0)
+                out += keep_defect * e + (W.sum() - w) * uf
+                for sj, Wj in zip(sig, W, strict=True):
+                    if Wj != 0.0 and sj != 0.0:
+                        out += Wj * (self._eval(cu, points, sj) - u0)
+                return out
+            for sj, Wj in zip(sig, W, strict=True):
+                out += Wj * self._eval(cu, points, sj)
+            return out - w * self._eval(cu, points, 0.0)
 
         return StepMemory(
-            scale=solid.J0 + dJ * r / den,
-            offset=history(self.points, e, ep),  # the film points' own values at zero shift
-            weight=dJ * r / den,
-            grid_offset=history(self.grid),
-            _at=history,
+            scale=solid.J0 + w,
+            offset=offset(self.points, film=True),
+            weight=w,
+            grid_offset=offset(self.grid),
+            _at=offset,
             _to_grid=self.to_grid,
-            _film=self._film_defect,
-        )
-
-    def _film_defect(self, grid_values, film_values):
-        """The state array: the grid values and the film points' defect against them."""
-        return np.concatenate(
-            [grid_values, film_values - self._eval(self._spline(grid_values), self.points, 0.0)]
+            _state=self._state,
         )

@@ -1,0 +1,1 @@
+"""Reference solutions femehl is validated against, computed by other methods than its time stepping."""

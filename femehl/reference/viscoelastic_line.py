@@ -1,0 +1,106 @@
+"""Steady sliding of a rigid cylinder on a standard-linear-solid Winkler foundation.
+
+Independent of femehl's time stepping: the steady equations are solved directly as a
+two-point boundary value problem by collocation (:func:`scipy.integrate.solve_bvp`).
+
+At steady sliding (V, hc constant) the line contact of :mod:`femehl.line` on the foundation
+``Viscoelastic(G0, tau, G_inf, elastic=Winkler(k))`` has the film
+``d = hc + x^2/2 + J0 p/k + q``; the Reynolds equation integrates once to a constant
+flux (as in :mod:`femehl.line_steady`) and the creep's memory equation
+``tau_c Dq/Dt = dJ p/k - q`` with ``D/Dt = -2 V d/dx`` (the material moves at ``-2V``)
+is an ODE along x::
+
+    beta d^3 p' = -V (d - d_*),        -2 V tau_c q' = dJ p/k - q,    dJ = J_inf - J0,
+    p(-L) = p(L) = 0,   q(L) = 0  (the material enters at x = L unloaded, with no creep),
+
+with ``d_*`` (the film where p' = 0) a free parameter: three conditions for two first
+order equations and one parameter.  The solution is continued in ``dJ`` from the elastic
+one of :mod:`femehl.line_steady` (compliance J0).  Energetics (:mod:`femehl.tribology`,
+per unit length, ``W = -(J0 p/k + q)``)::
+
+    f = int [V/(6 beta d) - (W + d/2) p'] dx,   D_film = int [V^2/(6 beta d) + (beta/2) d^3 p'^2] dx,
+    P_sliding = -V int W p' dx = V int q p' dx,  and  f V = D_film + P_sliding.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SceneError, SolverError
+
+__all__ = ["SteadyViscoelasticLine", "steady_viscoelastic_line"]
+
+
+@dataclass(frozen=True)
+class SteadyViscoelasticLine:
+    """The steady solution: headline figures and its fields on ``x``."""
+
+    load: float
+    film_center: float
+    film_min: float
+    friction: float
+    dissipation_film: float
+    power_sliding: float
+    d_star: float
+    x: np.ndarray
+    p: np.ndarray
+    q: np.ndarray
+    d: np.ndarray
+
+
+def steady_viscoelastic_line(
+    k: float, beta: float, hc: float, L: float, V: float, solid, *, tol: float = 1e-8, steps: int = 4
+) -> SteadyViscoelasticLine:
+    """Steady sliding at speed ``V`` and clearance ``hc`` on ``solid`` (a
+    :class:`femehl.Viscoelastic`, its elastic part taken as ``Winkler(k)``) on ``[-L, L]``.
+
+    ``tol`` is solve_bvp's residual tolerance, ``steps`` the continuation steps in dJ.
+    """
+    from scipy.integrate import solve_bvp
+
+    from ..line_steady import steady_line
+
+    if not V > 0.0:
+        raise SceneError(f"the steady sliding reference needs V > 0, got {V!r}.")
+    J0, dJ_end, tc = solid.J0, solid.J_inf - solid.J0, solid.tau_creep
+    el = steady_line(k / J0, beta, hc, L, V, full=True)
+    x = np.linspace(-L, L, 2001)
+    y, par = np.vstack([el.pressure(x), np.zeros_like(x)]), np.array([el.d_star])
+    sol = None
+    for dJ in np.linspace(0.0, dJ_end, steps + 1)[1:] if dJ_end > 0.0 else [0.0]:
+
+        def rhs(x, y, par, dJ=dJ):
+            d = hc + 0.5 * x * x + J0 * y[0] / k + y[1]
+            return np.vstack([-V * (d - par[0]) / (beta * d**3), (y[1] - dJ * y[0] / k) / (2.0 * V * tc)])
+
+        def bc(ya, yb, par):
+            return np.array([ya[0], yb[0], yb[1]])
+
+        sol = solve_bvp(rhs, bc, x, y, p=par, tol=tol, max_nodes=500_000)
+        if sol.status != 0:
+            raise SolverError(f"steady viscoelastic line: solve_bvp failed at dJ = {dJ:g} ({sol.message})")
+        x, y, par = sol.x, sol.y, sol.p
+    xs = np.union1d(np.linspace(-L, L, 20001), sol.x)
+    p, q = sol.sol(xs)
+    d = hc + 0.5 * xs**2 + J0 * p / k + q
+    dp = -V * (d - sol.p[0]) / (beta * d**3)
+    W = -(J0 * p / k + q)
+
+    def integral(f):
+        return float(np.trapezoid(f, xs))
+
+    return SteadyViscoelasticLine(
+        load=integral(p),
+        film_center=float(hc + J0 * sol.sol(0.0)[0] / k + sol.sol(0.0)[1]),
+        film_min=float(d.min()),
+        friction=integral(V / (6.0 * beta * d) - (W + 0.5 * d) * dp),
+        dissipation_film=integral(V * V / (6.0 * beta * d) + 0.5 * beta * d**3 * dp * dp),
+        power_sliding=-V * integral(W * dp),
+        d_star=float(sol.p[0]),
+        x=xs,
+        p=p,
+        q=q,
+        d=d,
+    )

@@ -79,6 +79,7 @@ sphere are within tol with the estimate >= half the true error at >= 90 % of the
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import time
@@ -87,7 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.adaptive import LOAD_FLOOR, UNIT_STEP
+from .core.adaptive import LOAD_FLOOR, UNIT_STEP, breakpoints_of
 from .errors import SceneError, SolverError, TimeBudgetError
 from .result import Result
 
@@ -279,7 +280,29 @@ def pair_error(fine: Result, coarse: Result, name: str, ratio: float) -> np.ndar
     """
     qf = getattr(fine, name)
     qc = np.array([coarse.value_at(name, t) for t in fine.t])
+    scene = getattr(fine, "scene", None)
+    if getattr(getattr(scene, "substrate", None), "instant", False):
+        qc = _across_jumps(coarse, name, fine.t, qc, breakpoints_of(scene))
     return np.abs(qf - qc) / (ratio**ORDER - 1.0) / _scale(name, qf)
+
+
+def _across_jumps(coarse, name, ts, qc, breaks) -> np.ndarray:
+    """``coarse``'s ``name`` at ``ts`` where it jumps at its start and at the motion's
+    ``breaks`` (a substrate whose pressure follows hc' at once): within each stretch
+    ``(a, b]`` from the coarse levels after ``a`` only, extrapolated linearly back to ``a``."""
+    tc = np.asarray(coarse.t, dtype=float)
+    q = np.array([coarse.value_at(name, t) for t in tc])
+    out = qc.copy()
+    edges = [tc[0], *sorted(b for b in breaks if tc[0] < b < tc[-1]), math.inf]
+    for a, b in itertools.pairwise(edges):
+        inside = (tc > a) & (tc <= b)
+        if inside.sum() < 2:
+            continue
+        t1, t2 = tc[inside][:2]
+        q1, q2 = q[inside][:2]
+        early = (ts > a) & (ts < t1)
+        out[early] = q1 + (ts[early] - t1) * (q2 - q1) / (t2 - t1)
+    return out
 
 
 def time_error(res: Result) -> np.ndarray:

@@ -21,6 +21,9 @@ class Rigid:
     kind = "rigid"
     #: every operator is sparse (none at all): see :data:`femehl.auto.LOCAL_MAX_ELEMENTS`
     local = True
+    #: the pressure follows the motion at once (algebraic in hc'): the load jumps where hc'
+    #: does (t = 0, breakpoints), which the adaptive steps do not count as a time error
+    instant = True
 
     def compliance_operator(self, disc):
         return sp.csr_matrix((disc.film_points.shape[0], disc.n))

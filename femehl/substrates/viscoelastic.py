@@ -213,6 +213,15 @@ class Viscoelastic:
         """The internal variable's integrator on ``disc`` (used by the stepper)."""
         return CreepMemory(self, disc)
 
+    def dry_contact(self, shape):
+        """The relaxed solid's (``G_inf``: the softest, so the deepest under a load), with the
+        geometric overlap as its extent (a sliding contact's hysteresis shifts it)."""
+        from .contact import DryContact, _dry_contact
+
+        relaxed = _dry_contact(self.elastic, shape).load
+        load = None if relaxed is None else (lambda delta: self.G_inf * relaxed(delta))
+        return DryContact(shape.overlap_axes, load, "the viscoelastic substrate")
+
 
 @dataclass(frozen=True)
 class StepMemory:
@@ -266,7 +275,7 @@ class CreepMemory:
     ``t_{k+1}`` was at ``x + sigma(theta)`` a time ``theta`` earlier, ``sigma = 2 int V``
     (V linear over the step).  With the source linear in time between ``u^k`` (on the
     path) and ``u^{k+1}`` (its increment taken at the arrival point ``x``: an
-    ``O(dt^2 V du/dx)`` error, second order, zero in a steady state),
+    ``O(dt^2 V du/dx)`` error, second order, zero in a steady state)::
 
         q^{k+1}(x) = e^{-r} q^k(x + s) + (dJ/tau_c) int_0^dt e^{-theta/tau_c} u^k(x + sigma) dtheta
                      + w [u^{k+1}(x) - u^k(x)],       r = dt/tau_c,  s = sigma(dt),

@@ -492,6 +492,14 @@ def _chain(handlers):
     return each
 
 
+def companion_to(scene, method, t_end, t_fit, level, store_every, options) -> Result:
+    """The companion run of a resumed automatic run again, to a later ``t_end``: ``level``'s
+    discretization fitted to ``t_fit`` (the first run's end, as the candidate's mesh)."""
+    ladder = LADDERS[method]
+    fitted = Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
+    return _run(scene, method, fitted, t_end, level, 0, dict(options))
+
+
 def _next_level(level: float, err: float, tol: float) -> float:
     """The level predicted to bring the error to SAFETY * tol, within RATIO_RANGE of ``level``."""
     lo, hi = RATIO_RANGE

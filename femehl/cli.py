@@ -240,6 +240,11 @@ def _run(args, argv=()):
         )
     except KeyboardInterrupt:
         return _interrupted(out, argv)
+    if res.info.get("nothing_to_do"):
+        print(
+            f"femehl: {out} already holds the run to t = {res.t[-1]:g}: nothing to do (give a larger --t-end)"
+        )
+        return EXIT_DONE
     from .output.plots import FIGURES, plot_animation
 
     names = [name for name, _ in FIGURES[res.disc.dimension]]
@@ -396,10 +401,16 @@ def _print_choice(res) -> None:
         for n, k, w in zip(a["elements"], a["steps"], a["wall"], strict=True)
     )
     status = "reached" if a["reached"] else f"NOT reached ({a.get('stopped') or 'budget'})"
+    total = a.get("total", float("nan"))
+    err = (
+        "no estimate: one run only"
+        if not math.isfinite(total)
+        else f"estimated error up to {100 * total:.2g} %"
+    )
     accepted = 100 * a["accept"] * a["tol"]
     print(
         f"femehl: automatic to tol = {a['tol']:g} ({status}): runs {runs}; the answer is the last "
-        f"(estimated error up to {100 * a.get('total', float('nan')):.2g} %, accepted at <= {accepted:.2g} %)"
+        f"({err}, accepted at <= {accepted:.2g} %)"
     )
 
 

@@ -22,6 +22,8 @@ import logging
 import pathlib
 import time
 
+import numpy as np
+
 from .api import make_stepper, run_loop
 from .errors import OutputError, SceneError, SolverError
 from .output import RunWriter, checkpoint, draw_figures
@@ -189,7 +191,9 @@ def run_to_folder(
     if saved_auto is None and not is_automatic(scene, method, dt, options):
         refuse_auto_only(options)
         res = _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
-        if not resume:  # the space estimate from the coarser companion (a resumed run: its part only)
+        if not resume and not res.info.get(
+            "nothing_to_do"
+        ):  # the space estimate from the coarser companion (a resumed run: its part only)
             _expert_estimate(scene, pathlib.Path(folder), res, dt, tol, options, t_end, say)
         return res
     if dt is not None:
@@ -236,7 +240,13 @@ def _automatic(
         )
 
     def runner(*, level, tol_t, options, previous):
-        plan = {"tol": tol, "level": level, "tol_t": tol_t, "companion": auto.companion_record(previous)}
+        plan = {
+            "tol": tol,
+            "level": level,
+            "tol_t": tol_t,
+            "t_fit": t_end,
+            "companion": auto.companion_record(previous),
+        }
         if not first["candidate"]:
             plan["replaces"] = True  # a finer candidate replaces the coarser one's files
         try:
@@ -245,14 +255,22 @@ def _automatic(
             first["candidate"] = False
 
     if resume:
-        companion = auto.CompanionSeries(saved["companion"])
-        # the saved candidate finishes: the budgets of the sequence no longer apply
+        # the saved candidate goes on, on the mesh it was fitted with (to the run's first
+        # t_end); the budgets of the sequence no longer apply
+        t_fit = float(saved.get("t_fit", saved["companion"]["t"][-1]))
         kept = {k: v for k, v in options.items() if k not in ("max_wall", "max_elements")}
-        options = {**auto.LADDERS[method].options(scene, t_end, saved["level"]), **kept}
+        ladder = auto.LADDERS[method]
+        options = {**ladder.options(scene, t_fit, saved["level"]), **kept}
         res = stream(options, saved, resume=True)
+        if res.info.get("nothing_to_do"):
+            return res
         res.info.update(level=saved["level"], tol_t=saved["tol_t"])
-        ratio = saved["companion"]["level"] / saved["level"]
-        res.estimate = auto.estimate(res, companion, ratio)
+        level_c = float(saved["companion"]["level"])
+        companion = auto.CompanionSeries(saved["companion"])
+        if t_end > companion.t[-1] * (1.0 + 1e-9):  # extended: its companion goes on too
+            say(f"femehl: the coarser companion (level {level_c:.3g}) again to t = {t_end:g} (the estimate)")
+            companion = auto.companion_to(scene, method, t_end, t_fit, level_c, store_every, kept)
+        res.estimate = _continued(folder, auto.estimate(res, companion, level_c / saved["level"]))
         res.info["auto"] = {"tol": saved["tol"], "resumed": True}
     else:
         say(f"femehl: automatic run to tol = {tol:g} (pilot runs in memory, then the run itself)")
@@ -270,6 +288,18 @@ def _automatic(
         except SolverError as exc:
             say(f"femehl: run stopped at t = {exc.t}: {exc}")
             raise
+        if first["candidate"]:  # the budget ended the sequence in its pilots: write the last one
+            say(
+                f"femehl: the budget ended the sequence before a run that could be the answer; "
+                f"writing the last pilot (level {res.info['level']:.3g}) into {folder}"
+            )
+            try:
+                res.save(folder, overwrite=overwrite)
+            except OSError as exc:
+                raise OutputError(
+                    f"cannot write into {str(folder)!r} ({exc.strerror or exc}): free space or fix "
+                    "permissions, then run again."
+                ) from exc
     _write_estimate(folder, res)
     res.info["wall_s"] = time.perf_counter() - t0  # pilots and candidates
     a = res.info.get("auto", {})
@@ -285,6 +315,35 @@ def _automatic(
             + f": accepted at <= {a['accept']:g} tol)"
         )
     return res
+
+
+def _continued(folder, est: dict) -> dict:
+    """A resumed run's estimate going on from its earlier part's (saved when it was resumed):
+    the total is a running maximum over the whole run and the time part accumulates."""
+    from .output.table import EARLIER_ESTIMATE, _earlier_estimate
+
+    before = _earlier_estimate(folder / "summary.csv")
+    if not before:
+        return est
+    last = before[max(before, key=float)]
+
+    def cell(q, part):
+        try:
+            return float(last.get(f"err_{q}" if part == "total" else f"err_{q}_{part}", "nan"))
+        except ValueError:
+            return float("nan")
+
+    for q, parts in est.items():
+        if q == "t" or parts["total"] is None:
+            continue
+        total0, time0 = cell(q, "total"), cell(q, "time")
+        if not np.isfinite(total0):
+            continue
+        total = np.maximum(parts["total"], total0)
+        tpart = np.minimum(parts["time"] + (time0 if np.isfinite(time0) else 0.0), total)
+        est[q] = {"total": total, "space": total - tpart, "time": tpart}
+    logger.info("femehl: the estimate goes on from the one in %s", folder / EARLIER_ESTIMATE)
+    return est
 
 
 def _pilot_bar(desc, t_end):
@@ -313,12 +372,21 @@ def _write_estimate(folder, res) -> None:
 
     from .output.table import add_error_columns
 
-    if res.estimate is not None:
-        add_error_columns(folder / "summary.csv", res.estimate)
-        _redraw_history(folder)
-    if "auto" in res.info:
-        info = {k: v for k, v in res.info["auto"].items()}
-        (folder / "auto.json").write_text(json.dumps(info, indent=1, default=float))
+    try:
+        if res.estimate is not None:
+            add_error_columns(folder / "summary.csv", res.estimate)
+            _redraw_history(folder)
+        if "auto" in res.info:
+            info = {k: v for k, v in res.info["auto"].items()}
+            tmp = folder / "auto.json.tmp"
+            tmp.write_text(json.dumps(info, indent=1, default=float))
+            tmp.replace(folder / "auto.json")
+    except OSError as exc:
+        raise OutputError(
+            f"cannot write the error estimate into {str(folder)!r} ({exc.strerror or exc}): the run's "
+            "files are there without it; free space or fix permissions, then resume (--resume) to "
+            "write it."
+        ) from exc
 
 
 def _stream(
@@ -362,7 +430,18 @@ def _stream(
         say(f"femehl: cavitation: {stepper.info['cavitation_note']}")
 
     # ---- everything is checked: from here on the folder is written ----
-    removed = prepare_folder(folder, overwrite=overwrite)
+    try:
+        removed = prepare_folder(folder, overwrite=overwrite)
+        if resume and not t_end <= start.t + 1e-9 * max(1.0, start.t):
+            writer = checkpoint.resume_writer(folder, stepper.disc, store_every, start.t)
+        elif not resume:
+            writer = RunWriter(folder, stepper.disc, every=store_every)
+            checkpoint.write_params(folder, params)
+    except OSError as exc:
+        raise OutputError(
+            f"cannot write into {str(folder)!r} ({exc.strerror or exc}): free space or fix "
+            "permissions, then run again (or resume: --resume)."
+        ) from exc
     if removed:
         if auto_plan is not None and auto_plan.get("replaces"):
             say(
@@ -375,13 +454,14 @@ def _stream(
         say(f"femehl: resuming from the checkpoint at t = {start.t:g} (step {start.step})")
         if t_end <= start.t + 1e-9 * max(1.0, start.t):
             say(
-                f"femehl: the run in {folder} is already at t_end = {t_end:g}: nothing to do "
-                "(give a larger t_end to go on)"
+                f"femehl: the run in {folder} is already at t_end = {t_end:g}: nothing to do, "
+                "nothing rewritten (give a larger t_end to go on)"
             )
-        writer = checkpoint.resume_writer(folder, stepper.disc, store_every, start.t)
-    else:
-        writer = RunWriter(folder, stepper.disc, every=store_every)
-        checkpoint.write_params(folder, params)
+            done = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
+            done.record(start, store_fields=False)
+            done.info.update(getattr(stepper, "info", {}), steps=0, wall_s=time.perf_counter() - t0)
+            done.info["nothing_to_do"] = True
+            return done
     bar = None
     if progress:
         from .output.progress import TimeBar

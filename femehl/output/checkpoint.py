@@ -393,6 +393,18 @@ def _align_summary(path: pathlib.Path, columns: tuple) -> None:
     if not rows or tuple(rows[0]) == tuple(columns):
         return
     where = {c: i for i, c in enumerate(rows[0])}
+    from .table import EARLIER_ESTIMATE, ERROR_COLUMNS
+
+    kept = [c for c in ERROR_COLUMNS if c in where]
+    earlier = path.with_name(EARLIER_ESTIMATE)
+    if kept and not earlier.is_file():  # the finished part's estimate, merged back at the end
+        tmp = earlier.with_name(earlier.name + ".tmp")
+        with open(tmp, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["t", *kept])
+            for r in rows[1:]:
+                w.writerow([r[0]] + [r[where[c]] if where[c] < len(r) else "" for c in kept])
+        os.replace(tmp, earlier)
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)

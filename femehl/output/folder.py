@@ -30,6 +30,7 @@ RUN_FILES = (
     "animation.gif",
     "line.png",
     "auto.json",
+    "summary_estimate_before_resume.csv",
 )
 _SERIES = re.compile(r"fields_\d+\.vtu$")
 _MAPS = re.compile(r"maps_t[-+.\w]+\.png$")  # femehl plot maps RUN --t T

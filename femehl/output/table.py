@@ -125,12 +125,17 @@ ERROR_QUANTITIES = ("load", "film_center", "film_min")
 ERROR_COLUMNS = tuple(c for q in ERROR_QUANTITIES for c in (f"err_{q}", f"err_{q}_space", f"err_{q}_time"))
 
 
+#: a resumed run's folder keeps the estimate of its earlier part here until its end
+EARLIER_ESTIMATE = "summary_estimate_before_resume.csv"
+
+
 def add_error_columns(path, estimate: dict) -> pathlib.Path:
     """Rewrite the summary CSV at ``path`` with :data:`ERROR_COLUMNS` from ``estimate``.
 
     ``estimate`` is a Result's (``{"t": ..., name: {"total", "space", "time"}}``); rows
-    at times outside its span (before a resumed run's start) get empty cells.  The new
-    file replaces the old one atomically.
+    at times before its span (a resumed run's earlier part) keep the estimate they had
+    (:data:`EARLIER_ESTIMATE`, saved when the run was resumed), else get empty cells.
+    The new file replaces the old one atomically.
     """
     import numpy as np
 
@@ -153,14 +158,32 @@ def add_error_columns(path, estimate: dict) -> pathlib.Path:
                 out.append("" if v is None or not inside else f"{float(np.interp(t, ts, v)):.4g}")
         return out
 
+    before = _earlier_estimate(path)
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(header + list(ERROR_COLUMNS))
         for row in rows[1:]:
-            w.writerow([row[i] for i in keep] + cells(float(row[0])))
+            t = float(row[0])
+            new = cells(t)
+            if t <= ts[0] + span and row[0] in before:  # a resumed run: its earlier part's
+                new = [before[row[0]].get(c, "") for c in ERROR_COLUMNS]
+            w.writerow([row[i] for i in keep] + new)
     tmp.replace(path)
+    path.with_name(EARLIER_ESTIMATE).unlink(missing_ok=True)
     return path
+
+
+def _earlier_estimate(path) -> dict:
+    """``{t cell: {column: cell}}`` of the estimate a resumed run's earlier part had."""
+    earlier = pathlib.Path(path).with_name(EARLIER_ESTIMATE)
+    if not earlier.is_file():
+        return {}
+    with open(earlier, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        return {}
+    return {r[0]: dict(zip(rows[0][1:], r[1:], strict=False)) for r in rows[1:] if r}
 
 
 def read_summary(path) -> dict:

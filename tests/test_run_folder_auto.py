@@ -1,0 +1,82 @@
+"""An automatic run's folder: resumed, extended, cut short by its budget, or out of disk, it
+never loses what it wrote and never ends in a bare traceback."""
+
+from __future__ import annotations
+
+import errno
+import json
+
+import numpy as np
+import pytest
+
+import femehl
+from femehl.errors import OutputError
+from femehl.output.table import ERROR_COLUMNS, read_summary
+from femehl.run import run_to_folder
+
+SCENE = femehl.presets.paper_sphere()
+RUN = dict(t_end=0.3, tol=5e-2, store_every=5)
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("auto") / "run"
+    run_to_folder(SCENE, folder, **RUN)
+    return folder
+
+
+def _copy(src, dst):
+    import shutil
+
+    shutil.copytree(src, dst)
+    return dst
+
+
+def test_resuming_a_finished_automatic_run_rewrites_nothing(finished, tmp_path):
+    folder = _copy(finished, tmp_path / "run")
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    res = run_to_folder(SCENE, folder, resume=True, **RUN)
+    assert res.info["nothing_to_do"]
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+
+
+def test_an_automatic_run_extends_and_keeps_its_earlier_estimate(finished, tmp_path):
+    folder = _copy(finished, tmp_path / "run")
+    old = read_summary(folder / "summary.csv")
+    res = run_to_folder(SCENE, folder, resume=True, **{**RUN, "t_end": 0.45})
+    new = read_summary(folder / "summary.csv")
+    n = old["t"].size
+    assert new["t"][-1] == pytest.approx(0.45) and new["t"].size > n
+    np.testing.assert_array_equal(new["t"][:n], old["t"])
+    for c in ERROR_COLUMNS:  # the earlier part's estimate is the one it had
+        np.testing.assert_array_equal(new[c][:n], old[c])
+        assert np.all(np.isfinite(new[c][n:])), c  # and the new part has one
+    assert res.info["auto"]["resumed"]
+    # the extension is the same run as one made to 0.45 at once on that mesh: the load at
+    # t = 0.45 within the estimate (the companion re-run gives it)
+    assert res.uncertainty("load", 0.45)["total"] < RUN["tol"]
+    assert not (folder / "summary_estimate_before_resume.csv").exists()
+
+
+def test_a_budget_spent_in_the_pilots_writes_the_last_pilot(tmp_path):
+    folder = tmp_path / "run"
+    res = run_to_folder(SCENE, folder, t_end=1.0, tol=1e-2, max_wall=0.4)
+    assert not res.info["auto"]["reached"]
+    assert res.info["auto"]["stopped"] == "time budget"
+    table = read_summary(folder / "summary.csv")
+    assert table["t"][-1] == pytest.approx(1.0)
+    np.testing.assert_allclose(table["load"], res.load, rtol=1e-9)
+    assert json.loads((folder / "auto.json").read_text())["stopped"] == "time budget"
+
+
+def test_a_full_disk_at_the_estimate_is_femehls_error(tmp_path, monkeypatch):
+    import femehl.output.table as table
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(table, "add_error_columns", full)
+    folder = tmp_path / "run"
+    with pytest.raises(OutputError, match="No space left.*resume"):
+        run_to_folder(SCENE, folder, **RUN)
+    assert (folder / "summary.csv").is_file()  # what was written stays

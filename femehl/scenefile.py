@@ -150,6 +150,9 @@ def _build(registry, table, where, path):
         raise SceneFileError(
             f"{path}: [{where}] kind = {kind!r} does not take {sorted(extra)}; it takes {sorted(allowed)}."
         )
+    for key, value in table.items():  # a nested table of the same registry (a relaxing solid's)
+        if isinstance(value, dict) and "kind" in value:
+            table[key] = _build(registry, value, f"{where}.{key}", path)
     try:
         return cls(**table)
     except SceneError as exc:

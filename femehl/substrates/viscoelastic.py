@@ -128,10 +128,6 @@ class Viscoelastic:
                 f"the unrelaxed modulus G0 = {G0:g} is below the relaxed one G_inf = {Gi:g}: a "
                 "standard linear solid stiffens under fast loading, so give G0 >= G_inf."
             )
-        if isinstance(self.elastic, dict):
-            from ..scenefile import substrate_from_mapping
-
-            object.__setattr__(self, "elastic", substrate_from_mapping(self.elastic))
         if not isinstance(self.elastic, Substrate) or isinstance(self.elastic, Viscoelastic):
             raise SceneError(
                 f"Viscoelastic(elastic=...) must be an elastic substrate such as femehl.HalfSpace() "

@@ -281,7 +281,14 @@ def _plot(args) -> int:
             "--t applies to femehl plot maps and centreline only (history and animation cover every time)."
         )
     own = {"animation": {"fps": args.fps}}.get(args.what, {"t": args.t} if args.what in TIMED_PLOTS else {})
-    path = FOLDER_PLOTS[args.what](args.folder, out=args.out, **own)
+    try:
+        path = FOLDER_PLOTS[args.what](args.folder, out=args.out, **own)
+    except KeyboardInterrupt:  # pictures are written atomically: nothing half-written
+        print(
+            "femehl: interrupted; the picture was not written (a file of that name, if any, is unchanged).",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
     print(f"femehl: wrote {path} in {time.perf_counter() - t0:.1f} s")
     return EXIT_DONE
 

@@ -39,6 +39,7 @@ Sweep file (``femehl sweep SWEEP.toml``)::
     [sweep]
     scene = "../examples/paper_sphere.toml"   # relative to this file; default: paper case
     out = "femehl-out/sweeps/beta"            # default: femehl-out/sweeps/<file name>
+    # max_cases = 20000                       # default MAX_CASES (counted before expanding)
 
     [grid]                                    # every combination (or [[cases]], [sample])
     "fluid.beta" = { logspace = [20, 20000], num = 12 }
@@ -49,6 +50,11 @@ Sweep file (``femehl sweep SWEEP.toml``)::
 
     [cluster]                                 # optional: scheduler = "tcp://host:8786",
     workers = 2                               #   memory_limit = "4GiB"
+
+Before the cluster starts, the file's value types, the number of cases and every
+case's scene and run options are checked (:func:`check_case_options`,
+:func:`check_cluster`); a sweep with cases that can't run is refused, and the message
+names them.
 """
 
 from __future__ import annotations
@@ -69,10 +75,14 @@ import numpy as np
 from .errors import FemehlError, OutputError, SceneError
 
 __all__ = [
+    "MAX_CASES",
     "RESULT_COLUMNS",
     "Case",
     "SweepPlan",
     "case_key",
+    "check_case_options",
+    "check_cluster",
+    "check_max_cases",
     "load_sweep_file",
     "plan_sweep",
     "read_results",

@@ -101,6 +101,11 @@ def plot_master_curves(out, x: str | None = None):
         x = numeric[0]
     if x not in names:
         raise OutputError(f"--x {x!r} is not a swept parameter of {out}: choose one of {names}.")
+    if x not in numeric:
+        raise OutputError(
+            f"--x {x!r} is not a number in every case (the x axis is logarithmic): choose one of "
+            f"{numeric or 'the numeric swept parameters (there are none)'}."
+        )
     if last.empty:
         raise OutputError(f"{out}: no finished case to plot (see the status column of results.parquet).")
     others = [n for n in names if n != x]

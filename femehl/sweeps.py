@@ -501,7 +501,7 @@ def plan_sweep(
         except _NameError:
             raise
         except (FemehlError, TypeError, ValueError) as exc:
-            bad.append(f"case {_show(params)}: {exc}")
+            bad.append(f"case {_show(params)}: {str(exc).rstrip('.')}")
             continue
         built.append(Case(case_key(scene, options), _jsonable(params), scene, options))
     if bad:

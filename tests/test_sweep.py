@@ -198,6 +198,10 @@ def test_master_curves_of_the_small_sweep(swept, capsys):
     assert main(["sweep", "plot", str(out), "--x", "domain.L"]) == 0
     assert main(["sweep", "plot", str(out), "--x", "fluid.bta"]) == 2
     assert "not a swept parameter" in capsys.readouterr().err
+    # run.mesh is swept (the failing case's mesh file) but is text: femehl's error, not numpy's
+    assert main(["sweep", "plot", str(out), "--x", "run.mesh"]) == 2
+    err = capsys.readouterr().err
+    assert "is not a number in every case" in err and "fluid.beta" in err
 
 
 def test_retry_failed_runs_the_failed_case_again(swept, capsys):

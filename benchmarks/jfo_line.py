@@ -81,7 +81,7 @@ def run(scene_kw, model, n):
     res = femehl.solve(sc, t_end=300.0, dt=0.5, n_elements=n, grading="uniform", estimate=False)
     wall = time.perf_counter() - t0
     s, x = res.final, res.disc.x
-    held = res.disc.expand((s.p_aux < 0).astype(float)) > 0
+    held = res.disc.expand((s.own["p_aux"] < 0).astype(float)) > 0
     beta = scene_kw["beta"]
     q = beta * s.d**3 * np.diff(s.p) / np.diff(x) + s.d  # -J per element, V = 1
     xe = 0.5 * (x[:-1] + x[1:])

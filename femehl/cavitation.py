@@ -66,6 +66,7 @@ import dataclasses
 
 import numpy as np
 
+from .core.parts import StepPart
 from .errors import SceneError
 
 __all__ = [
@@ -91,8 +92,9 @@ def register_cavitation(cls):
     return cls
 
 
-class _Model:
-    """What the registered models share (see the module docstring)."""
+class _Model(StepPart):
+    """What the registered models share (see the module docstring); a step part
+    (:mod:`femehl.core.parts`): its own variables ``p_aux`` (and JFO's ``gas``)."""
 
     name = ""
     changes_step = True
@@ -116,6 +118,17 @@ class _Model:
     def initial_state(self, state):
         """The initial state with the condition's own fields (by default ``state``)."""
         return state
+
+    # ---- its part in the step ------------------------------------------------------------
+    def initial(self, stepper, state):
+        state = dataclasses.replace(state, info={**state.info, **self.initial_info()})
+        return self.initial_state(state)
+
+    def lagged(self, state, free_index):
+        return self.lagged_pressure(state, free_index)
+
+    def rows(self, stepper, system, rhs_list, state, ctx):
+        return self.prepare(stepper, system, rhs_list, state, ctx)
 
     def point_fields(self, disc, state) -> dict:
         """Nodal fields the VTK series writes for the condition (every mesh node)."""
@@ -148,36 +161,14 @@ class _Model:
         """The columns' values at p = 0 (the initial state)."""
         return dict.fromkeys(self.columns, 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
-        """The state the step returns, from the one built from the solved pressure.
-
-        Parameters
-        ----------
-        stepper : femehl.core.stepper.LaggedStepper
-            The stepper (``stepper.g``: load weights, ``stepper.disc``).
-        op : femehl.core.linsolve.StepOperator
-            The step's operator *without* the held rows replaced.
-        rhs : ndarray
-            Its right-hand side without the ``-G h`` part (``A p - b = D p + G d - rhs``).
-        p : ndarray
-            The solved pressure unknowns.
-        new : femehl.stepping.State
-            The state built from ``p`` (film, deflection, load, extremes).
-        fixed : object
-            What :meth:`prepare` returned as ``aux`` (the rows held at ``p = 0``).
-        scale : float, default: 1.0
-            The factor ``op.G`` carries (a viscoelastic step's ``J_eff``): the terms' film
-            operator is ``op.G / scale``.
-        unknowns : ndarray, optional
-            The condition's own unknowns, from the solution after the pressure (JFO: the
-            gas film); empty for the others.
-
-        Returns
-        -------
-        femehl.stepping.State
-            ``new`` with the condition's ``p_aux``, ``info`` figures and, for a condition
-            that reports otherwise, its reported fields.
-        """
+    def finish(self, stepper, solved, new):
+        """The state the step returns, from ``new`` (built from the solved pressure) and
+        ``solved`` (:class:`femehl.core.parts.Solved`: the operator without held rows, its
+        right-hand side without the ``-G h`` part, ``A p - b = D p + G d - rhs``, the
+        pressure, what :meth:`prepare` returned as ``aux``, the scale ``op.G`` carries, the
+        condition's own unknowns after the pressure): ``new`` with the condition's
+        ``p_aux``, ``info`` figures and, for a condition that reports otherwise, its
+        reported fields."""
         raise NotImplementedError
 
 
@@ -234,15 +225,16 @@ class ReynoldsCavitation(_Model):
     @staticmethod
     def fixed(state) -> np.ndarray:
         """Free-node indices held at p = 0 in the step after ``state``."""
-        y = getattr(state, "p_aux", None)
+        y = state.own.get("p_aux")
         if y is None:
             return np.zeros(0, dtype=np.int64)
         return np.flatnonzero(np.asarray(y) < 0.0)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
+    def finish(self, stepper, solved, new):
         """``p_aux = y``: ``p`` off the held set, ``-(A p - b)`` on it (the multiplier of the
         unmasked system): the next step's set is ``{y < 0}``; area, extremes and the mass
         source go to ``info``."""
+        op, rhs, p, fixed, scale = solved.op, solved.rhs, solved.p, solved.aux, solved.scale
         y = np.array(p, dtype=float)
         info = dict(new.info)
         lam = np.zeros(0)
@@ -255,7 +247,7 @@ class ReynoldsCavitation(_Model):
         free[fixed] = False
         info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
         info["full_film_source"] = _plane_factor(stepper.disc) * float(lam.sum())
-        return dataclasses.replace(new, info=info, p_aux=y)
+        return dataclasses.replace(new, info=info).with_own(p_aux=y)
 
 
 @register_cavitation
@@ -302,12 +294,12 @@ class HalfSommerfeld(_Model):
     @staticmethod
     def lagged_pressure(state, free_index) -> np.ndarray:
         """The full-Sommerfeld pressure (``p_aux``; the clipped ``p`` before the first step)."""
-        y = getattr(state, "p_aux", None)
+        y = state.own.get("p_aux")
         return np.asarray(state.p)[free_index] if y is None else np.asarray(y)
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
+    def finish(self, stepper, solved, new):
         """Clip: ``p``, ``load``, ``p_max`` of ``max(p, 0)``; ``p_aux`` the full ``p``."""
-        disc = stepper.disc
+        disc, p = stepper.disc, solved.p
         clipped = np.maximum(p, 0.0)
         p_full = disc.expand(clipped)
         i_max = int(np.argmax(p_full))
@@ -321,8 +313,7 @@ class HalfSommerfeld(_Model):
             p_max=float(p_full[i_max]),
             p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
             info=info,
-            p_aux=np.array(p, dtype=float),
-        )
+        ).with_own(p_aux=np.array(p, dtype=float))
 
 
 @register_cavitation
@@ -418,11 +409,11 @@ class JFOCavitation(_Model):
         """No gas yet; the liquid volume is the whole gap's."""
         info = dict(state.info)
         info["liquid_volume"] = self.plane * float(self.content_weight @ state.d)
-        return dataclasses.replace(state, gas=np.zeros(self.transport.n), info=info)
+        return dataclasses.replace(state, info=info).with_own(gas=np.zeros(self.transport.n))
 
     def point_fields(self, disc, state) -> dict:
         """``gas_film`` (``v``) and ``film_content`` (``theta = 1 - v/dbar``, 1 where full)."""
-        v = getattr(state, "gas", None)
+        v = state.own.get("gas")
         if v is None:
             return {}
         dbar = (disc.squeeze() @ np.asarray(state.d)) / disc.node_weight[disc.free_index]
@@ -441,10 +432,10 @@ class JFOCavitation(_Model):
         from .core.linsolve import SwitchedOperator
 
         n = op.D.shape[0]
-        y = getattr(state, "p_aux", None)
+        y = state.own.get("p_aux")
         switched = np.zeros(n, dtype=bool) if y is None else np.asarray(y) < 0.0
-        v = state.gas if state.gas is not None else np.zeros(n)
-        v_prev = state.gas_prev if state.gas_prev is not None else v
+        v = state.own.get("gas", np.zeros(n))
+        v_prev = state.own.get("gas_prev", v)
         hist_v = ctx.a1 * v - ctx.a2 * v_prev
         tr = self.transport
         B = tr.operator(ctx.V, ctx.a0 / ctx.dt)
@@ -457,8 +448,11 @@ class JFOCavitation(_Model):
         aux = {"switched": switched, "B": B, "hist_v": hist_v, "ctx": ctx, "gas": v, "corr": corr}
         return SwitchedOperator(op, B, switched), out, aux
 
-    def finish(self, stepper, op, rhs, p, new, fixed, scale=1.0, unknowns=None):
+    def finish(self, stepper, solved, new):
         """``p_aux = y`` (``p`` off the set, ``-v`` on it), ``gas = v``, the balance to ``info``."""
+        op, rhs, p, fixed, scale, unknowns = (
+            solved.op, solved.rhs, solved.p, solved.aux, solved.scale, solved.unknowns
+        )
         S = fixed["switched"]
         ctx = fixed["ctx"]
         v = np.where(S, np.asarray(unknowns, dtype=float), 0.0)
@@ -489,7 +483,7 @@ class JFOCavitation(_Model):
         if S.any():  # 1 - v / dbar, dbar the mean gap of the node's cell (its row's content)
             theta = float(np.min(1.0 - v[S] / dbar[S]))
         info["theta_min"] = theta
-        return dataclasses.replace(new, info=info, p_aux=y, gas=v, gas_prev=fixed["gas"])
+        return dataclasses.replace(new, info=info).with_own(p_aux=y, gas=v, gas_prev=fixed["gas"])
 
 
 def _plane_factor(disc) -> float:

@@ -87,7 +87,7 @@ class Result:
         info = state.info or {}
         self._rows["dt"].append(float(info.get("dt", 0.0)))
         self._rows["error_estimate"].append(float(info.get("error_estimate", np.nan)))
-        hc_dot = getattr(state, "hc_dot", None)  # a free indenter's velocity (NaN: hc imposed)
+        hc_dot = state.own.get("hc_dot")  # a free indenter's velocity (NaN: hc imposed)
         self._rows["hc_dot"].append(np.nan if hc_dot is None else float(hc_dot))
         if store_fields:
             self._stored.append(state)

@@ -10,6 +10,7 @@ step, so a caller can stop, store or plot whenever it likes.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -57,14 +58,14 @@ class State:
     info: dict = field(default_factory=dict)
     d_prev: np.ndarray | None = None  # d one step earlier (two-step schemes)
     dt_prev: float | None = None  # the step that led to this state
-    hc_dot: float | None = None  # a free indenter's velocity dhc/dt (None: hc is imposed)
-    hc_prev: float | None = None  # a free indenter's hc and velocity one step earlier
-    hc_dot_prev: float | None = None
-    p_aux: np.ndarray | None = None  # cavitation: p off the cavitated set, -multiplier on it
-    creep: np.ndarray | None = None  # viscoelastic substrate: delayed deflection q on the film points
-    creep_prev: np.ndarray | None = None  # q one step earlier (two-step schemes)
-    gas: np.ndarray | None = None  # JFO cavitation: gas film v on the pressure unknowns (0 where full)
-    gas_prev: np.ndarray | None = None  # v one step earlier (two-step schemes)
+    #: the step parts' own variables by name (:mod:`femehl.core.parts`: a free indenter's
+    #: ``hc_dot``, a viscoelastic memory's ``creep``, a cavitation condition's ``p_aux`` and
+    #: ``gas``), numbers or arrays; checkpoints write them as they are
+    own: dict = field(default_factory=dict)
+
+    def with_own(self, **values) -> State:
+        """This state with ``values`` added to (or replacing some of) its own variables."""
+        return dataclasses.replace(self, own={**self.own, **values})
 
 
 class Stepper(Protocol):

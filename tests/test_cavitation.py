@@ -333,8 +333,8 @@ def test_full_film_source_of_a_closed_cavity_is_the_liquid_created_where_the_fil
     s, disc = res.final, res.disc
     assert np.array_equal(res.states[-2].p, s.p)  # steady: the set and the field settled
     x, h = disc.x, np.diff(disc.x)
-    lam = np.where(s.p_aux < 0, -s.p_aux, 0.0)  # the multipliers of the held (free) nodes
-    held = disc.expand((s.p_aux < 0).astype(float)) > 0
+    lam = np.where(s.own["p_aux"] < 0, -s.own["p_aux"], 0.0)  # the multipliers of the held (free) nodes
+    held = disc.expand((s.own["p_aux"] < 0).astype(float)) > 0
     J = -BETA * s.d**3 * np.diff(s.p) / h - V * s.d  # element fluxes (steady: d* = d)
     lam_nodes = disc.expand(lam)
     exit_ = held & (x < -1.0)

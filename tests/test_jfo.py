@@ -59,7 +59,7 @@ def _fluxes(res):
     s, disc = res.final, res.disc
     x = disc.x
     J = -BETA * s.d**3 * np.diff(s.p) / np.diff(x) - V * s.d
-    held = disc.expand((s.p_aux < 0).astype(float)) > 0
+    held = disc.expand((s.own["p_aux"] < 0).astype(float)) > 0
     return x, -J, held
 
 
@@ -69,7 +69,7 @@ def test_liquid_is_conserved_through_rupture_and_reformation():
     res = _slider("jfo", _TwoConstrictions, t_end=60.0, dt=0.2)
     s = res.final
     assert abs(s.info["net_outflow"]) < 1e-10
-    assert np.array_equal(res.states[-2].p_aux < 0, s.p_aux < 0)  # the set settled
+    assert np.array_equal(res.states[-2].own["p_aux"] < 0, s.own["p_aux"] < 0)  # the set settled
     x, q, held = _fluxes(res)
     edges = np.flatnonzero(np.diff(held.astype(int)))  # the cavities' ends: [a1, b1, a2, b2]
     assert edges.size == 4  # one cavity open to the outlet, one closed between two films
@@ -97,7 +97,7 @@ def test_liquid_is_conserved_through_rupture_and_reformation():
 def test_open_cavity_is_the_reynolds_exit_condition():
     """The cavity runs to the outlet: no reformation, so JFO is Reynolds (rupture p = p' = 0)."""
     jfo, rey = _slider("jfo", n=200), _slider("reynolds", n=200)
-    assert np.array_equal(jfo.final.p_aux < 0, rey.final.p_aux < 0)
+    assert np.array_equal(jfo.final.own["p_aux"] < 0, rey.final.own["p_aux"] < 0)
     np.testing.assert_allclose(jfo.final.p, rey.final.p, rtol=0, atol=1e-12 * rey.final.p_max)
     assert jfo.final.film_min == pytest.approx(rey.final.film_min, rel=1e-12)
 
@@ -190,7 +190,7 @@ def test_resume_series_and_columns(tmp_path):
     run_to_folder(sc, tmp_path / "b", t_end=0.75, scheme="bdf2", **opts)
     resumed = run_to_folder(sc, tmp_path / "b", t_end=1.5, resume=True, scheme="bdf2", **opts)
     assert np.array_equal(resumed.final.p, whole.final.p)
-    assert np.array_equal(resumed.final.gas, whole.final.gas)
+    assert np.array_equal(resumed.final.own["gas"], whole.final.own["gas"])
     a, b = (read_summary(tmp_path / s / "summary.csv") for s in "ab")
     extra = tuple(c for c in a if not c.startswith("err_"))[len(COLUMNS) :]
     assert extra == femehl.cavitation.JFOCavitation.columns
@@ -231,7 +231,7 @@ def test_pocket_slider_against_the_exact_steady_solution():
     assert abs(s.info["net_outflow"]) < 1e-9  # steady
     assert s.load == pytest.approx(ref.load, rel=1e-4)
     assert np.abs(s.p - ref.pressure(x)).max() < 3e-4 * s.p.max()
-    held = res.disc.expand((s.p_aux < 0).astype(float)) > 0
+    held = res.disc.expand((s.own["p_aux"] < 0).astype(float)) > 0
     h = np.diff(x).max()
     (a, b) = x[held].min(), x[held].max()  # the cavity's nodes
     assert a == pytest.approx(ref.reformation[0], abs=2 * h)

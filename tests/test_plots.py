@@ -356,7 +356,7 @@ def test_line_contact_shades_the_cavitated_interval():
     assert any(lab.startswith("cavitated (p held at 0)") for lab in ax.get_legend_handles_labels()[1])
     ((a, b),) = [_span(p) for p in ax.patches]
     x = res.disc.x
-    held = x[res.disc.expand((res.final.p_aux < 0).astype(float)) > 0]  # p_aux: free nodes
+    held = x[res.disc.expand((res.final.own["p_aux"] < 0).astype(float)) > 0]  # p_aux: free nodes
     assert a <= held.min() and held.max() <= b
     assert b - a == pytest.approx(res.final.info["cavitated_area"], abs=2 * np.diff(x).max())
     matplotlib.pyplot.close(fig)

@@ -70,7 +70,7 @@ def cavitation_pictures(tmp):
     free = disc.free_index
     theta = np.ones(disc.nodes.shape[0])  # the nodes' filling 1 - v/dbar, on y = 0
     dbar = (disc.squeeze() @ st.d) / disc.node_weight[free]
-    theta[free] = 1.0 - st.gas / dbar
+    theta[free] = 1.0 - st.own["gas"] / dbar
     on = np.zeros(theta.size, dtype=bool)
     on[free] = np.abs(disc.nodes[free, 1]) < 1e-12
     order = np.argsort(disc.nodes[on, 0])

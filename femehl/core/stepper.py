@@ -9,11 +9,8 @@ that is ``A p = b`` with ``A = D + G C``, ``G = sum c_term F_term`` and
 operators, the substrate its compliance ``C`` (``w = -C p`` on the film points, see
 :mod:`femehl.substrates`), the linear solver (:mod:`femehl.core.linsolve`) solves.
 
-Imposed load ``F(t)`` instead of an imposed gap: ``hc^{k+1}`` is one more unknown.  The
-right-hand side is affine in hc (``h = hc + s``), so with ``A x1 = b(h = s)`` and
-``A x2 = G 1`` the bordered system ``A p + hc G 1 = b(s)``, ``g . p = F`` gives
-``hc = (g . x1 - F) / (g . x2)`` and ``p = x1 - hc x2``: one operator, two right-hand
-sides, still one linear system per step.  This is the only place it is written.
+Beside the terms, the step's parts (:mod:`femehl.core.parts`): the motion's unknown hc
+(imposed gap, imposed load, free indenter), a substrate's memory, a cavitation condition.
 
 After the solve the film is known everywhere the discretization can tell: on its film
 points, at the origin (exact compliance row) and at the nodes where a cheap estimate of
@@ -25,7 +22,6 @@ the film points' own minimum), and a film <= 0 anywhere raises
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numpy as np
@@ -34,6 +30,7 @@ import scipy.sparse as sp
 from ..errors import SceneError, SingularSystemError
 from ..stepping import State, get_scheme
 from .linsolve import StepOperator, film_rtol_scale, make_linear_solver
+from .parts import Solved, gap_control
 from .terms import StepContext, terms_for
 
 __all__ = ["LaggedStepper"]
@@ -127,6 +124,10 @@ class LaggedStepper:
             self.cavitation.setup(disc)
         memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
         self.memory = None if memory is None else memory(disc)
+        #: what takes part in the step beside the terms (femehl.core.parts): the motion's
+        #: unknown hc, then the substrate's memory and the fluid's cavitation condition
+        self.gap = gap_control(scene.motion)
+        self.parts = [part for part in (self.memory, self.cavitation) if part is not None]
         from ..output.table import extra_columns
         from ..tribology import TRIBOLOGY_COLUMNS
 
@@ -201,9 +202,7 @@ class LaggedStepper:
         return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
 
     # ---- states -------------------------------------------------------------------------
-    def _state(
-        self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, hc_dot=None, mem=None
-    ) -> State:
+    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, mem=None) -> State:
         disc = self.disc
         if Cp is None:
             Cp = np.asarray(self.C @ p).ravel()
@@ -243,7 +242,6 @@ class LaggedStepper:
             info=info,
             d_prev=d_prev,
             dt_prev=dt_prev,
-            hc_dot=hc_dot,
         )
 
     def _probe(self, hc, p, defl, d_min, mem=None):
@@ -286,13 +284,9 @@ class LaggedStepper:
 
     def initial_state(self) -> State:
         mo = self.scene.motion
-        hc_dot = mo.hc_dot0 if mo.free else None
-        info = self.cavitation.initial_info() if self.cavitation is not None else None
-        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n), info=info, hc_dot=hc_dot)
-        if self.memory is not None:  # the material at rest, unloaded
-            state = dataclasses.replace(state, creep=np.zeros(self.memory.size))
-        if self.cavitation is not None:  # a condition's own fields (JFO: no gas yet)
-            state = self.cavitation.initial_state(state)
+        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n))
+        for part in (self.gap, *self.parts):  # their own variables at rest
+            state = part.initial(self, state)
         self._budget(state)
         return state
 
@@ -306,9 +300,46 @@ class LaggedStepper:
 
     # ---- one step -----------------------------------------------------------------------
     def step(self, state: State, t_new: float, dt: float) -> State:
-        """One lagged step: ONE linear system (bordered by one row under imposed load)."""
-        mo = self.scene.motion
-        V = mo.V(t_new)
+        """One lagged step: terms -> extra unknowns -> ONE linear solve -> state."""
+        ctx = self._context(state, t_new, dt)
+        film = self._film(state, t_new, dt)
+        scale = 1.0 if film is None else film.scale
+        op, rhs = self.operator(ctx, scale)
+        G = op.G if film is None else op.G / scale  # the terms' G (op.G carries the film's scale)
+        shape = self.shape if film is None else self.shape + film.offset
+        system, rhs_list = op, self.gap.rhs(self, rhs, G, shape, t_new)
+        auxes = []
+        for part in self.parts:  # rows held, or unknowns added
+            system, rhs_list, aux = part.rows(self, system, rhs_list, state, ctx)
+            auxes.append(aux)
+        its0 = self.solver.info.get("krylov_iterations", 0)
+        solutions = self.solver.solve(system, rhs_list, t_new)
+        x, Cp, hc, own = self.gap.close(self, solutions, state, t_new, dt, ctx)
+        if not (np.all(np.isfinite(x)) and np.isfinite(hc)):  # a part's unknowns too
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
+                "or ill-conditioned. Try a smaller dt or a finer discretization.",
+                t=t_new,
+            )
+        n = self.disc.n
+        p = x[:n]
+        self.info.update(self.solver.info)
+        info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
+        if self.solver.residuals:
+            info["residual"] = max(self.solver.residuals)
+        if Cp is None:
+            Cp = np.asarray(self.C @ p).ravel()
+        new = self._state(state.step + 1, t_new, hc, ctx.V, p, Cp, state.d, dt, info, film)
+        self._budget(new)
+        if own:
+            new = new.with_own(**own)
+        for part, aux in zip(self.parts, auxes, strict=True):
+            solved = Solved(state, ctx, op, rhs, p, Cp, x[n:], aux, film, scale)
+            new = part.finish(self, solved, new)
+        return new
+
+    def _context(self, state: State, t_new: float, dt: float) -> StepContext:
+        """The terms' lagged context: the scheme's coefficients, the lagged film and pressure."""
         omega = None if state.d_prev is None or not state.dt_prev else dt / state.dt_prev
         a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
         if l1 == 0.0:
@@ -316,12 +347,13 @@ class LaggedStepper:
         else:  # extrapolated coefficient, kept positive
             d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
             hist = a1 * state.d - a2 * state.d_prev
-        cav = self.cavitation
         free_index = self.disc.free_index
-        p_old = state.p[free_index] if cav is None else cav.lagged_pressure(state, free_index)
-        its0 = self.solver.info.get("krylov_iterations", 0)
+        p_old = state.p[free_index]
+        for part in self.parts:
+            lagged = part.lagged(state, free_index)
+            p_old = p_old if lagged is None else lagged
         self.solver.rtol_scale = film_rtol_scale(state.d, state.w)  # the residual follows the film
-        ctx = StepContext(
+        return StepContext(
             t_new=t_new,
             dt=dt,
             a0=a0,
@@ -329,94 +361,15 @@ class LaggedStepper:
             d_lag=d_lag,
             history=hist,
             p=p_old,
-            V=V,
+            V=self.scene.motion.V(t_new),
             beta=self.beta,
             a1=a1,
             a2=a2,
         )
-        mem = None
-        if self.memory is not None:  # viscoelastic: d = h + offset + J_eff C p
-            mem = self.memory.step(state, t_new, dt, a0, a1, a2, mo.V)
-        scale = 1.0 if mem is None else mem.scale
-        shape = self.shape if mem is None else self.shape + mem.offset
-        op, rhs = self.operator(ctx, scale)
-        G = op.G if mem is None else op.G / scale  # the terms' G (op.G carries the scale)
-        hc_dot = None
-        if mo.solves_hc:  # p = x1 - hc x2, and one more row for hc
-            rhs_list = [rhs - G @ shape, G @ np.ones(self.shape.size)]
-        else:
-            hc = mo.hc(t_new)
-            rhs_list = [rhs - G @ (hc + shape)]
-        system, aux = op, None
-        if cav is not None:  # the condition's system: held rows, or more unknowns
-            system, rhs_list, aux = cav.prepare(self, op, rhs_list, state, ctx)
-        if mo.solves_hc:
-            (x1, cx1), (x2, cx2) = self.solver.solve(system, rhs_list, t_new)
-            n = self.disc.n  # a condition's own unknowns follow the pressure
-            g1, g2 = float(self.g @ x1[:n]), float(self.g @ x2[:n])
-            if mo.free:
-                hc, hc_dot = self._newton_row(state, t_new, dt, g1, g2, a0, a1, a2)
-            else:  # the load row: g . p = F
-                if not np.isfinite(g2) or g2 == 0.0:
-                    raise SingularSystemError(
-                        f"step at t = {t_new:.6g}: the load row is singular (the film does not "
-                        "respond to hc).",
-                        t=t_new,
-                    )
-                hc = (g1 - mo.F(t_new)) / g2
-            x = x1 - hc * x2
-            Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
-        else:
-            ((x, Cp),) = self.solver.solve(system, rhs_list, t_new)
-        p, unknowns = x[: self.disc.n], x[self.disc.n :]
-        if not (np.all(np.isfinite(x)) and np.isfinite(hc)):  # a condition's unknowns too
-            raise SingularSystemError(
-                f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
-                "or ill-conditioned. Try a smaller dt or a finer discretization.",
-                t=t_new,
-            )
-        self.info.update(self.solver.info)
-        info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
-        if self.solver.residuals:
-            info["residual"] = max(self.solver.residuals)
-        new = self._state(
-            state.step + 1, t_new, hc, V, p, Cp, d_prev=state.d, dt_prev=dt, info=info, hc_dot=hc_dot, mem=mem
-        )
-        extra = {}
-        if mem is not None:
-            u = Cp if Cp is not None else np.asarray(self.C @ p).ravel()
-            extra.update(creep=mem.creep(u), creep_prev=state.creep)
-        self._budget(new)
-        if hc_dot is not None:
-            extra.update(hc_prev=state.hc, hc_dot_prev=state.hc_dot)
-        if extra:
-            new = dataclasses.replace(new, **extra)
-        if cav is not None:  # the condition's part after the solve (unmasked system)
-            new = cav.finish(self, op, rhs, p, new, aux, scale, unknowns)
-        return new
 
-    def _newton_row(self, state, t_new, dt, g1, g2, a0, a1, a2):
-        """hc and dhc/dt of a free indenter: ``m hc'' = load - force`` by the step's own
-        scheme (BDF2 with its variable-step coefficients, or Euler) on hc and v = hc':
-
-            a0 hc' - (a1 hc - a2 hc_prev) = dt v',   m (a0 v' - (a1 v - a2 v_prev)) = dt f',
-
-        ``f' = g . p' - force(t')`` with ``g . p' = g1 - hc' g2`` linear in hc': one more
-        row, solved in closed form.  L-stable: a small mass tends to the imposed-load step
-        (``hc' = (g1 - force)/g2`` at m = 0)."""
-        mo = self.scene.motion
-        m = mo.mass
-        v = state.hc_dot if state.hc_dot is not None else mo.hc_dot0
-        if a2 != 0.0 and state.hc_prev is not None and state.hc_dot_prev is not None:
-            h_hist, v_hist = a1 * state.hc - a2 * state.hc_prev, a1 * v - a2 * state.hc_dot_prev
-        else:  # the first step (or after a restart without history): the one-step scheme
-            a0, h_hist, v_hist = 1.0, state.hc, v
-        F_new = mo.applied_force(t_new)
-        den = m * a0 * a0 / dt + dt * g2
-        if not np.isfinite(den) or den == 0.0:
-            raise SingularSystemError(
-                f"step at t = {t_new:.6g}: the free indenter's row is singular (m a0^2/dt + dt g.x2 = 0).",
-                t=t_new,
-            )
-        hc = (dt * (g1 - F_new) + (m / dt) * (a0 * h_hist + dt * v_hist)) / den
-        return hc, (a0 * hc - h_hist) / dt
+    def _film(self, state: State, t_new: float, dt: float):
+        """The step's change of the film (``d = h + offset + scale C p``), at most one part's."""
+        films = [f for f in (part.film(self, state, t_new, dt) for part in self.parts) if f is not None]
+        if len(films) > 1:
+            raise SceneError("two step parts change the film: femehl composes at most one.")
+        return films[0] if films else None

@@ -90,13 +90,8 @@ def save_checkpoint(folder, state: State) -> pathlib.Path:
     arrays["has_prev"] = np.asarray(state.d_prev is not None)
     arrays["d_prev"] = np.asarray(state.d_prev, dtype=float) if state.d_prev is not None else np.zeros(0)
     arrays["dt_prev"] = np.asarray(np.nan if state.dt_prev is None else state.dt_prev, dtype=float)
-    arrays["p_aux"] = np.zeros(0) if state.p_aux is None else np.asarray(state.p_aux, dtype=float)
-    for k in _INTERNAL:  # a viscoelastic substrate's memory, a JFO film's gas
-        v = getattr(state, k)
-        arrays[k] = np.zeros(0) if v is None else np.asarray(v, dtype=float)
-    for k in ("hc_dot", "hc_prev", "hc_dot_prev"):  # a free indenter's motion
-        v = getattr(state, k)
-        arrays[k] = np.asarray(np.nan if v is None else v, dtype=float)
+    for k, v in state.own.items():  # the step parts' own variables, as they are
+        arrays[OWN + k] = np.asarray(v, dtype=float)
     for k in CAVITATION_COLUMNS:  # a cavitation condition's per-step figures (summary columns)
         if k in (state.info or {}):
             arrays[f"info_{k}"] = np.asarray(float(state.info[k]))
@@ -115,14 +110,6 @@ def _scalar(a: dict, key: str, path, kind=float):
     if v.size != 1:
         raise _bad(path, f"its entry {key!r} is not a single value (shape {v.shape})")
     return kind(v.reshape(()).item())
-
-
-def _optional(a: dict, key: str, path):
-    """A scalar entry that older checkpoints do not have (None if absent or NaN)."""
-    if key not in a:
-        return None
-    v = _scalar(a, key, path)
-    return None if math.isnan(v) else v
 
 
 def load_checkpoint(folder, reference: State | None = None) -> State:
@@ -178,25 +165,31 @@ def load_checkpoint(folder, reference: State | None = None) -> State:
         info={"resumed": True, **cav_info},
         d_prev=arrays["d_prev"] if has_prev else None,
         dt_prev=None if math.isnan(dt_prev) else dt_prev,
-        # absent from checkpoints written before free indenters
-        hc_dot=_optional(a, "hc_dot", path),
-        hc_prev=_optional(a, "hc_prev", path),
-        hc_dot_prev=_optional(a, "hc_dot_prev", path),
-        p_aux=np.asarray(a["p_aux"], dtype=float) if "p_aux" in a and a["p_aux"].size else None,
-        **{k: _optional_array(a, k) for k in _INTERNAL},  # absent from older checkpoints
+        own=_own(a, path),
     )
     if reference is not None:
         check_state(state, reference, path)
     return state
 
 
-#: internal variables of a state (None when the run has none): viscoelastic memory, JFO gas
-_INTERNAL = ("creep", "creep_prev", "gas", "gas_prev")
+#: the prefix of a step part's own variable in the file (``state.own``)
+OWN = "own_"
+#: the fixed names that checkpoints written before 2026-12-05 gave those variables
+_LEGACY = ("hc_dot", "hc_prev", "hc_dot_prev", "p_aux", "creep", "creep_prev", "gas", "gas_prev")
 
 
-def _optional_array(a, key):
-    """An array entry absent from older checkpoints (or empty: not used by the run), else None."""
-    return np.asarray(a[key], dtype=float) if key in a and a[key].size else None
+def _own(a: dict, path) -> dict:
+    """The step parts' own variables of a checkpoint (an older file's under their old names:
+    absent, empty or NaN meant "the run has none")."""
+    own = {k.removeprefix(OWN): v for k, v in a.items() if k.startswith(OWN)}
+    for k in _LEGACY:
+        if k in a and a[k].size and not (a[k].size == 1 and math.isnan(float(a[k].reshape(-1)[0]))):
+            own.setdefault(k, a[k])
+    out = {}
+    for k, v in own.items():
+        v = np.asarray(v, dtype=float)
+        out[k] = _scalar({k: v}, k, path) if v.ndim == 0 else v
+    return out
 
 
 def check_state(state: State, reference: State, path="checkpoint") -> None:
@@ -213,16 +206,14 @@ def check_state(state: State, reference: State, path="checkpoint") -> None:
             f"its array 'd_prev' has shape {np.shape(state.d_prev)}, "
             f"the discretization needs {np.shape(reference.d)}",
         )
-    for k in _INTERNAL:
-        v = getattr(state, k)
-        ref = getattr(reference, k.removesuffix("_prev"))
-        want = np.shape(ref) if ref is not None else None
-        if v is not None and (np.shape(v) != want or not np.all(np.isfinite(v))):
-            what = "viscoelastic memory" if k.startswith("creep") else "JFO gas film"
+    for k, v in state.own.items():  # the step parts' own variables: finite, sized as the run's
+        ref = reference.own.get(k, reference.own.get(k.removesuffix("_prev")))
+        want = np.shape(v) if ref is None else np.shape(ref)
+        if np.shape(v) != want or not np.all(np.isfinite(v)):
             raise _bad(
                 path,
-                f"its array {k!r} has shape {np.shape(v)} or non-finite values; the "
-                f"discretization's {what} needs {want} finite values",
+                f"its variable {k!r} has shape {np.shape(v)} or non-finite values; the run "
+                f"needs {want} finite values",
             )
 
 

@@ -142,7 +142,7 @@ def cavitated_nodes(disc, state):
     that keeps them there, or negative and joining the set at the next step; half-Sommerfeld:
     the nodes whose full-Sommerfeld pressure was clipped), 0.0 elsewhere; None for a
     full-Sommerfeld run (no complementarity variable)."""
-    y = getattr(state, "p_aux", None)
+    y = state.own.get("p_aux")
     if y is None:
         return None
     return disc.expand((np.asarray(y) < 0.0).astype(float))

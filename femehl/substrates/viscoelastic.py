@@ -69,6 +69,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from ..core.parts import StepPart
 from ..errors import SceneError
 from ..tribology import ENERGETICS_COLUMNS
 from ..validation import check_positive
@@ -256,7 +257,7 @@ def _phi(r):
     return -np.expm1(-r) - b, b
 
 
-class CreepMemory:
+class CreepMemory(StepPart):
     """Exponential integrator of ``tau_c Dq/Dt = (J_inf - J0) u - q`` along the characteristics.
 
     State.  The internal variable lives on a uniform grid aligned with the sliding
@@ -427,15 +428,26 @@ class CreepMemory:
         keep = np.abs(sig) <= (self.shape[1] + 1) * self.dx  # beyond: no source there
         return sig[keep], dJ * W[keep]
 
-    # ---- one step -----------------------------------------------------------------------
-    def step(self, state, t_new: float, dt: float, a0=None, a1=None, a2=None, V=None) -> StepMemory:
-        """The step's scale and offset from the material's history (``state.creep``).
+    # ---- its part in the step (femehl.core.parts) ------------------------------------------
+    def initial(self, stepper, state):
+        """The material at rest, unloaded: ``state.own["creep"] = 0``."""
+        return state.with_own(creep=np.zeros(self.size))
 
-        Exact along the characteristic whatever the step (class docstring): the stepper's
-        backward-difference coefficients ``a0, a1, a2`` are not used.
+    def film(self, stepper, state, t_new: float, dt: float) -> StepMemory:
+        return self.step(state, t_new, dt, stepper.scene.motion.V)
+
+    def finish(self, stepper, solved, new):
+        """The internal variable after the step, from the step's ``u = C p``."""
+        return new.with_own(creep=solved.film.creep(solved.Cp))
+
+    # ---- one step -----------------------------------------------------------------------
+    def step(self, state, t_new: float, dt: float, V) -> StepMemory:
+        """The step's scale and offset from the material's history (``state.own["creep"]``).
+
+        Exact along the characteristic whatever the step (class docstring).
         """
         solid = self.solid
-        q, e, ug, uf = self.split(np.zeros(self.size) if state.creep is None else state.creep)
+        q, e, ug, uf = self.split(state.own.get("creep", np.zeros(self.size)))
         V0, V1 = float(V(state.t)), float(V(t_new))
         s = dt * (V0 + V1)  # 2 int V dt over the step
         r = dt / solid.tau_creep

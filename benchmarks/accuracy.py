@@ -46,7 +46,7 @@ import time
 HERE = pathlib.Path(__file__).resolve().parent
 T_END = 5.0
 MESHES = ("coarse", "medium", "fine", "xfine")
-RATIO = 1.45  # femehl.fe.mesh.LADDER_RATIO (checked in the worker)
+RATIO = 1.45  # femehl.discretize.mesh.LADDER_RATIO (checked in the worker)
 XPROF = (-1.5, 1.5, 301)
 QUANTS = (
     "load@1",
@@ -165,15 +165,15 @@ def worker(spec):
     import femehl
     from femehl.api import make_stepper
     from femehl.errors import SolverError
-    from femehl.result import Result
-    from femehl.stepping import march
+    from femehl.output.result import Result
+    from femehl.solver.stepping import march
 
     t_end = spec.get("t_end", T_END)
     dt = spec["dt"]
     load0 = os.getloadavg()[0]
     scene = femehl.presets.paper_sphere(beta=spec.get("beta", 200.0))
     if spec["solver"] == "fe":
-        from femehl.fe.mesh import LADDER_RATIO
+        from femehl.discretize.mesh import LADDER_RATIO
 
         assert abs(LADDER_RATIO - RATIO) < 1e-12
         opts = dict(mesh=spec["mesh"], scheme=spec["scheme"])

@@ -64,7 +64,7 @@ def worker(spec: dict) -> dict:
     import numpy as np
 
     import femehl
-    from femehl.fe.fitted import fitted_disk
+    from femehl.discretize.fitted import fitted_disk
 
     factory, t_end = _scenes()[spec["scene"]]
     scene = factory()
@@ -382,13 +382,13 @@ def targets(records: list, refs: dict) -> list:
 
 def pair_estimate(a: dict, b: dict, t_from: float) -> float:
     """The automatic mode's estimate of the finer fixed-step run ``b`` from the coarser ``a``
-    (records with ``level``, ``t`` and the series): ``femehl.auto.pair_error``, worst over the
+    (records with ``level``, ``t`` and the series): ``femehl.accuracy.auto.pair_error``, worst over the
     quantities and over the times ``t >= t_from`` (the compared window)."""
     from types import SimpleNamespace
 
     import numpy as np
 
-    from femehl.auto import CompanionSeries, pair_error
+    from femehl.accuracy.auto import CompanionSeries, pair_error
 
     fine = SimpleNamespace(t=np.asarray(b["t"]), **{q: np.asarray(b[q]) for q in QUANTITIES})
     coarse, ratio = CompanionSeries(a), a["level"] / b["level"]
@@ -403,11 +403,11 @@ def cost_target(records: list, refs: dict, scene: str = "paper", tol: float = 1e
     A certified answer needs its estimate: from a second run, coarser, in the automatic
     mode.  The cheapest such pair on the hand grid: two runs of the same step ``dt`` (the
     estimate sees the space error only; the time error is then the same in both), the finer
-    one's pair estimate (:func:`pair_estimate`) at most ``femehl.auto.ACCEPT * tol`` and at
+    one's pair estimate (:func:`pair_estimate`) at most ``femehl.accuracy.auto.ACCEPT * tol`` and at
     least its worst true error (an estimate that does not bound the error certifies
     nothing).  The grid has the levels :data:`HAND_LEVELS` and :data:`HAND_LEVELS_PAPER`, so
     this is the grid's figure, not a bound over every level."""
-    from femehl.auto import ACCEPT
+    from femehl.accuracy.auto import ACCEPT
 
     ref = _ref(refs, scene)
     hand = [h for h in records if h["kind"] == "hand" and h["scene"] == scene and h.get("status") == "ok"]

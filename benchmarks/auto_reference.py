@@ -22,7 +22,7 @@ import numpy as np
 
 import femehl
 from femehl import Ellipsoid, Motion, RampHold, Scene, TanhStart
-from femehl.fe.fitted import fitted_disk
+from femehl.discretize.fitted import fitted_disk
 
 T_END = 1.5
 DT = 0.0025

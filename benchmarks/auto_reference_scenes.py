@@ -5,7 +5,7 @@ and ``film_min`` (and where the minimum film is) to ``t_end``:
 
 * FE, BDF2 at the FIXED step ``DT = 0.005`` (``DT / 2`` for the scenes of
   :data:`DT_OVERRIDES`, the time error there as large as the errors checked), on the fitted meshes
-  ``femehl.fe.fitted.fitted_disk(scene, t_end, level)`` at two levels ``L_a = 0.7`` and
+  ``femehl.discretize.fitted.fitted_disk(scene, t_end, level)`` at two levels ``L_a = 0.7`` and
   ``L_b = 0.5`` (size ratio ``r = L_a / L_b = 1.4``, about twice the elements);
 * the reference is the Richardson extrapolation in h of order 2 at every time of the
   series (both runs have the same fixed times):
@@ -14,7 +14,7 @@ and ``film_min`` (and where the minimum film is) to ``t_end``:
   correction), and the time-discretization error is measured once per scene by a third
   run at level ``L_a`` with ``dt = 2 DT``: ``max_t |q(2 DT) - q(DT)| / 3 / scale`` (BDF2,
   order 2: the error of the ``DT`` run).  ``scale = max(|q|, 0.1)`` for the load (a load
-  growing from 0 has no relative error; the floor of :mod:`femehl.auto`) and ``|q|`` for
+  growing from 0 has no relative error; the floor of :mod:`femehl.accuracy.auto`) and ``|q|`` for
   the films.  t = 0 is left out of the maxima.
 
 Budget rule: a scene whose level-0.5 mesh would exceed ``MAX_ELEMENTS_B = 16000``
@@ -78,7 +78,7 @@ ORDER = 2
 MAX_ELEMENTS_B = 16_000
 MAX_SCENE_S = 480.0
 QUANTITIES = ("load", "film_center", "film_min")
-LOAD_FLOOR = 0.1  # femehl.core.adaptive.LOAD_FLOOR, as femehl.auto uses it
+LOAD_FLOOR = 0.1  # femehl.solver.adaptive.LOAD_FLOOR, as femehl.auto uses it
 SIG = 10  # significant digits kept in the JSON
 #: scene -> (levels, reason): levels chosen by hand after a first reference.  Each such
 #: scene also gets a run at ``ratio * L_a`` ("coarse"), so three levels give the
@@ -262,7 +262,7 @@ def child(name: str, level: float, dt: float, t_end: float | None) -> dict:
     import numpy as np
 
     import femehl
-    from femehl.fe.fitted import fitted_disk
+    from femehl.discretize.fitted import fitted_disk
 
     scene, t_scene = _scene(name)
     t_run = t_scene if t_end is None else t_end
@@ -333,7 +333,7 @@ def estimate(name: str) -> dict:
     N^2; measured N^1.8-2.1 on the ladder).  With the levels (1.0, 0.7) the probe is the
     time-error run itself.
     """
-    from femehl.fe.fitted import fitted_sizes
+    from femehl.discretize.fitted import fitted_sizes
 
     scene, t_end = _scene(name)
     half = bool(getattr(scene.indenter, "symmetric_y", False))
@@ -572,7 +572,7 @@ def config() -> dict:
         "max_scene_s": MAX_SCENE_S,
         "load_floor": LOAD_FLOOR,
         "quantities": QUANTITIES,
-        "mesh": "femehl.fe.fitted.fitted_disk(scene, t_end, level)",
+        "mesh": "femehl.discretize.fitted.fitted_disk(scene, t_end, level)",
     }
 
 
@@ -730,7 +730,7 @@ Notes
   error up to 0.26 %).  beta = 20000: with the contact zone
   0.095 a (9.3 edge sizes, before 2026-12-03) levels 1 and 0.7 differed by 17 % at
   t ~ 0.6 and the reference was not in the asymptotic range; refined on 2026-12-03 on the
-  capped fitted meshes (`femehl.fe.fitted.C_CONTACT_EDGE`, `benchmarks/fitted_thin.md`),
+  capped fitted meshes (`femehl.discretize.fitted.C_CONTACT_EDGE`, `benchmarks/fitted_thin.md`),
   levels (1, 0.7), 24,736 and 50,120 elements, at dt = 0.0025: the film_min correction
   is 1.18 % at t = 0.715 in the approach (three levels not monotone there: not yet
   asymptotic) and 1.74 % at t = 1.985 in the sliding (observed order 2.8), time error

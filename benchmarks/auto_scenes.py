@@ -4,14 +4,14 @@ Every scene is built from femehl's public API only; ``factory()`` takes no argum
 returns a fresh :class:`femehl.Scene`.  Lengths and times are in the paper's units
 (README, "Normalization").  "Approach" is the paper's gap ramp ``RampHold(0.1, -1, 1)``
 with no sliding (velocity 0); "sliding" is the paper's motion (that ramp, then
-``V = tanh(t - 1)``, :func:`femehl.presets.paper_sphere`).  The end times are short so
+``V = tanh(t - 1)``, :func:`femehl.problem.presets.paper_sphere`).  The end times are short so
 that converged references (benchmarks/auto_reference_scenes.py) stay affordable on a
 2-core machine, but each reaches the regime it is there for.
 
 Scenes and why
 --------------
 ``paper``
-    :func:`femehl.presets.paper_sphere` (beta = 200, h0 = 0.1, L = 2) to t = 5: the
+    :func:`femehl.problem.presets.paper_sphere` (beta = 200, h0 = 0.1, L = 2) to t = 5: the
     paper's case and the default of ``femehl run``; sliding start-up to near steady.
 ``sphere_b{20,2000,20000}_approach``, t_end 1.5
     The paper sphere's squeeze only (indent to hc = -1 at t = 1, hold), at three beta
@@ -34,7 +34,7 @@ Scenes and why
     rounded edge, Sneddon radius 0.81 here; as in tests/test_fitted_mesh.py), then
     sliding with the paper's tanh start: the pressure peaks at the edge, not the centre.
 ``user_shape``, t_end 2
-    A :class:`femehl.indenters.Shape` from a Python callable, the sphere plus a ripple
+    A :class:`femehl.problem.indenters.Shape` from a Python callable, the sphere plus a ripple
     across the sliding direction ``s = r^2/2 + 0.05 (1 - cos 6x)`` (the Shape docstring's
     example, ``symmetric_y=True``: half disk), with the paper's motion.  The user-shape
     path (Sneddon ray by ray for the fitted mesh) and a non-monotone film.
@@ -65,7 +65,7 @@ import numpy as np
 
 import femehl
 from femehl import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, Winkler
-from femehl.indenters import FlatPunch, Shape
+from femehl.problem.indenters import FlatPunch, Shape
 
 __all__ = ["SCENES", "HERTZ_LOAD"]
 

@@ -37,7 +37,7 @@ ENV = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_TH
 #: 20.21 of 20.22 GB), where the paths were paired on 2026-12-04 at 3e0e5c7; earlier
 #: rows used 0.251 (44,792 elements) and 0.25 (45,156))
 LEVELS = [1.0, 0.5, 0.32, 0.244, 0.177, 0.125, 0.0735]
-#: the dense path is run where it fits (femehl.fe.mesh.dense_bytes <= 80 % of the memory)
+#: the dense path is run where it fits (femehl.discretize.mesh.dense_bytes <= 80 % of the memory)
 DENSE_LEVELS = [1.0, 0.5, 0.32, 0.244]
 #: the tighter fast operator of the agreement runs (p = 13 against the default's 11, double
 #: factors; p = 11 against 10 until 4cb7e0f; 3e-7 before that: p = 10 against 9)
@@ -45,7 +45,7 @@ TIGHT_OPERATOR_TOL = 1e-7
 
 
 def _scene():
-    from femehl.presets import paper_sphere
+    from femehl.problem.presets import paper_sphere
 
     return paper_sphere()
 
@@ -69,7 +69,7 @@ def case(
     """
 
     import femehl
-    from femehl.fe.fitted import fitted_disk
+    from femehl.discretize.fitted import fitted_disk
 
     scene = _scene()
     t0 = time.perf_counter()
@@ -143,7 +143,7 @@ SOURCES = (
 def _variant(spec: str) -> tuple[str, dict]:
     """``"p:eta:svd_ratio"`` -> (name, the run options that build the fast operator so:
     ``operator_tol = FastOptions(p=p, eta=eta, svd_ratio=svd_ratio)``), an experiment."""
-    from femehl.hmatrix import FastOptions
+    from femehl.elastic.hmatrix import FastOptions
 
     p, eta, ratio = spec.split(":")
     p, eta, ratio = int(p), float(eta), float(ratio)
@@ -171,7 +171,7 @@ def agree(
     import numpy as np
 
     import femehl
-    from femehl.fe.fitted import fitted_disk
+    from femehl.discretize.fitted import fitted_disk
 
     scene = _scene()
     dm = fitted_disk(scene, 5.0, level)
@@ -209,7 +209,7 @@ def agree(
     return out
 
 
-#: the couplings' truncation (femehl.hmatrix.SVD_RATIO) of the error rows recorded before
+#: the couplings' truncation (femehl.elastic.hmatrix.SVD_RATIO) of the error rows recorded before
 #: rows carried it: 0.1 until 566eb3b, then 1
 _SVD_BEFORE = {"36c856f": 0.1, "6759f61": 0.1, "566eb3b": 1.0}
 
@@ -230,23 +230,23 @@ def operator_error(
 ) -> list[dict]:
     """Relative error of the fast operator at each ``operator_tol`` on the fitted mesh of
     ``level``, against exact rows at ``rows`` elements drawn uniformly
-    (:func:`femehl.hmatrix.sampled_error`): so it is measured where the dense operator
+    (:func:`femehl.elastic.hmatrix.sampled_error`): so it is measured where the dense operator
     does not fit.
 
     For ``n_vectors`` random vectors at once (standard normal nodal values; the Frobenius
     ratio over them: one vector's error scatters by a factor of 5) and a smooth one
     (``1 - r**2`` inside the unit circle, the shape of a Hertz pressure).  ``p``,
     ``svd_ratio`` and ``eta`` override the order, truncation and admissibility of the
-    default (:class:`femehl.hmatrix.FastOptions`; experiment rows, tagged and not the
+    default (:class:`femehl.elastic.hmatrix.FastOptions`; experiment rows, tagged and not the
     default's).  One record per tolerance,
     with the Chebyshev order, the far factors' precision, the build seconds and bytes of
     the operator (the preconditioner's coarse space is not built).
     """
     import numpy as np
 
-    from femehl.discretizations.fe_disk import FEDisc
-    from femehl.fe.fitted import fitted_disk
-    from femehl.hmatrix import FastCompliance, FastOptions, sampled_error
+    from femehl.discretize.fe_disk import FEDisc
+    from femehl.discretize.fitted import fitted_disk
+    from femehl.elastic.hmatrix import FastCompliance, FastOptions, sampled_error
 
     scene = _scene()
     disc = FEDisc(scene, mesh=fitted_disk(scene, 5.0, level), operator="fast")

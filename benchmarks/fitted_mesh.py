@@ -5,7 +5,7 @@ Scenes (FE, BDF2, dt = 0.01, to t = 3, half disk: all are symmetric in y):
 * ``ellipsoid``: the shipped example (``examples/ellipsoid_sliding.py``),
   Ellipsoid(Rx = 0.5, Ry = 2), hc -> -0.5, beta = 200;
 * ``ellipsoid_x``: the same turned by 90 degrees, Rx = 2, Ry = 0.5;
-* ``sphere``: the paper sphere (``femehl.presets.paper_sphere()``);
+* ``sphere``: the paper sphere (``femehl.problem.presets.paper_sphere()``);
 * ``sphere_b2000``: the same at beta = 2000 (films 5x thinner: the edge band narrows).
 
 Each is run on the ladder meshes and on ``fitted_disk(scene, 3, level)`` for
@@ -19,7 +19,7 @@ Part two measures the exit zone of the paper sphere against beta (fine ladder
 mesh, BDF2, dt = 0.02, t = 3, centreline y = 0): the distance ``e`` from the
 Hertz edge x = -1 to where the film, past its exit minimum, has doubled.  It
 justifies the edge-band half-width ``W(beta) = 1.17 beta^(-1/3)`` of
-:mod:`femehl.fe.fitted`.
+:mod:`femehl.discretize.fitted`.
 
 Run (about 8 minutes on 2 cores)::
 
@@ -46,8 +46,8 @@ import numpy as np  # noqa: E402
 from _machine import machine  # noqa: E402
 
 import femehl  # noqa: E402
-from femehl.fe.fitted import contact_extent, fitted_disk  # noqa: E402
-from femehl.fe.mesh import LADDER_RATIO, load_mesh  # noqa: E402
+from femehl.discretize.fitted import contact_extent, fitted_disk  # noqa: E402
+from femehl.discretize.mesh import LADDER_RATIO, load_mesh  # noqa: E402
 
 HERE = pathlib.Path(__file__).resolve().parent
 T_END, DT = 3.0, 0.01

@@ -5,7 +5,7 @@ pressed to hc = -1 over t in [0, 1] at beta = 20000, no sliding), FE, BDF2 at a 
 dt = 0.0025 to t = 1, on ``fitted_disk(scene, 1.5, level)``:
 
 * ``cap``: femehl's size field, the contact zone at most ``C_CONTACT_EDGE`` = 2.4 edge
-  sizes (:mod:`femehl.fe.fitted`, "Thin films"), levels 1.4, 1, 0.7;
+  sizes (:mod:`femehl.discretize.fitted`, "Thin films"), levels 1.4, 1, 0.7;
 * ``no cap``: the size field before 2026-12-03 (contact zone 0.095 a at every beta:
   ``C_CONTACT_EDGE = inf``), levels 1, 0.7.
 
@@ -45,7 +45,7 @@ def worker(variant: str, level: float) -> dict:
     from auto_scenes import SCENES
 
     import femehl
-    import femehl.fe.fitted as ff
+    import femehl.discretize.fitted as ff
 
     if variant == "no cap":
         ff.C_CONTACT_EDGE = math.inf
@@ -68,7 +68,7 @@ def worker(variant: str, level: float) -> dict:
 def analyze(runs: list) -> str:
     import numpy as np
 
-    import femehl.fe.fitted as ff
+    import femehl.discretize.fitted as ff
 
     ref = next(r for r in runs if r["variant"] == "cap" and r["level"] == min(c[1] for c in CASES))
     t = np.asarray(ref["t"])

@@ -35,7 +35,7 @@ def t_end(m):
 
 def run(m, dt):
     import femehl
-    from femehl.scene import Constant, Domain, Fluid, Motion, Scene
+    from femehl.problem.scene import Constant, Domain, Fluid, Motion, Scene
 
     sc = Scene(
         fluid=Fluid(BETA),

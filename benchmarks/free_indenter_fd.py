@@ -34,7 +34,7 @@ RUNS = [
 
 def run(method, opts):
     import femehl
-    from femehl.scene import Constant, Domain, Fluid, Motion, Scene
+    from femehl.problem.scene import Constant, Domain, Fluid, Motion, Scene
 
     sc = Scene(
         fluid=Fluid(1000.0),

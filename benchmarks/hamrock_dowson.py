@@ -5,7 +5,7 @@ half space under an imposed load (the Hertz load of ``hc = -1``, ``F = 4/(3 pi)`
 over ``t`` in [0, 1]; the load maps straight onto Hamrock and Dowson's load group ``W``,
 which stays the same for every ``alpha``), sliding from ``t = 1`` (``V = tanh(t - 1)``) to
 ``t = 8`` (steady: the change from ``t = 7`` to 8 is recorded), on ``L = 3`` with the
-scene-fitted mesh (:func:`femehl.fe.fitted.fitted_disk`, level 1), adaptive BDF2
+scene-fitted mesh (:func:`femehl.discretize.fitted.fitted_disk`, level 1), adaptive BDF2
 (``tol = 1e-3``), with a Barus viscosity ``exp(alpha p)`` for ``alpha`` = 0, 2.5, 5, 10
 and 20 (``alpha p_max`` about 0, 0.5, 1, 2 and 4: up to where ``benchmarks/viscosity.md``
 measured the lagged scheme stable) at ``beta`` = 200 and 1000.  The steady state does not
@@ -15,8 +15,8 @@ cases at each ``beta`` checks the mesh.
 
 Per case: femehl's central and minimum film, the Hamrock-Dowson isoviscous-elastic (1978)
 and piezoviscous-elastic (1977) films at ``eps = h_inf/R = 1e-3``
-(:mod:`femehl.theory`), the ratios, Hamrock's ``g_V`` and ``g_E``, the elastic regime
-(:func:`femehl.theory.hd_elastic_regime`), the central deflection over the film (the
+(:mod:`femehl.reference.theory`), the ratios, Hamrock's ``g_V`` and ``g_E``, the elastic regime
+(:func:`femehl.reference.theory.hd_elastic_regime`), the central deflection over the film (the
 contact is elastic when it is large) and the wall time.  Writes ``hamrock_dowson.md`` and
 ``hamrock_dowson.json`` next to this file; ``--resume`` keeps the cases already in the
 json.  Threads pinned to one.
@@ -52,8 +52,8 @@ BAND = 0.30
 
 def scene(beta: float, alpha: float):
     import femehl
-    from femehl import theory
-    from femehl.scene import Domain, Fluid, Motion, RampHold, Scene, TanhStart
+    from femehl.problem.scene import Domain, Fluid, Motion, RampHold, Scene, TanhStart
+    from femehl.reference import theory
 
     load = theory.hertz_load(1.0)
     return Scene(
@@ -67,7 +67,7 @@ def scene(beta: float, alpha: float):
 
 def run(beta: float, alpha: float, level: float) -> dict:
     import femehl
-    from femehl.fe.fitted import fitted_disk
+    from femehl.discretize.fitted import fitted_disk
 
     sc = scene(beta, alpha)
     t0 = time.perf_counter()
@@ -101,7 +101,7 @@ def run(beta: float, alpha: float, level: float) -> dict:
 
 
 def theory_of(rec: dict) -> dict:
-    from femehl import theory
+    from femehl.reference import theory
 
     beta, alpha, F = rec["beta"], rec["alpha"], rec["load"]
     g_V, g_E = theory.hd_regime_parameters(beta, F, alpha)
@@ -196,7 +196,8 @@ def write_md(runs):
         "load of hc = -1; ramped over t in [0, 1]), sliding V = tanh(t - 1), values at t = 8 "
         f"(steady: see the last column), L = {L:g}, scene-fitted mesh level {LEVEL:g}, adaptive BDF2 "
         f"tol = {TOL:g}, full Sommerfeld, Barus viscosity exp(alpha p). Hamrock-Dowson films at "
-        f"eps = h_inf/R = {EPS:g} (`femehl.theory`): IE = isoviscous-elastic (Hamrock & Dowson 1978: "
+        f"eps = h_inf/R = {EPS:g} (`femehl.reference.theory`): IE = isoviscous-elastic "
+        "(Hamrock & Dowson 1978: "
         "H_c = 7.32 U^0.64 W^-0.22 (1 - 0.72 e^-0.28k), H_min = 7.43 U^0.65 W^-0.21 (1 - 0.85 e^-0.31k)), "
         "PE = piezoviscous-elastic (Hamrock & Dowson 1977: H_c = 2.69 U^0.67 G^0.53 W^-0.067 "
         "(1 - 0.61 e^-0.73k), H_min = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^-0.68k)), with "
@@ -255,7 +256,7 @@ def verdict(base) -> list[str]:
         f"## Within +-{BAND:.0%} of the formula of the regime?",
         "",
         "No accuracy of the fits could be found stated in the accessible sources (the papers "
-        "themselves were not accessible; see `femehl.theory.hd_film` and `hd_piezo_film`). The "
+        "themselves were not accessible; see `femehl.reference.theory.hd_film` and `hd_piezo_film`). The "
         f"yardstick here is +-{BAND:.0%}: the mean deviation of measured minimum films from the 1977 "
         "formula in Koye & Winer's optical experiment (J. Lubr. Technol. 103 (1981) 284; "
         "+30 % on average). It is not the formulas' stated accuracy.",

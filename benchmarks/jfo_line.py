@@ -3,12 +3,12 @@
 ``python benchmarks/jfo_line.py`` runs femehl's transient line-contact solver
 (``LineScene(cavitation="jfo")``, and ``"reynolds"`` beside it) to its steady state on
 uniform meshes of 200 to 1600 elements, and compares with the independent exact steady
-solution of :mod:`femehl.line_jfo_steady` (quadrature and shooting; its own uncertainty
+solution of :mod:`femehl.reference.line_jfo_steady` (quadrature and shooting; its own uncertainty
 <= 2e-9):
 
 * ``b1``: the cylinder ``x^2/2`` on a Winkler foundation (k = 1, beta = 10, hc = -0.5):
   the film ruptures behind the contact and the cavity runs to the outlet (JFO = Reynolds);
-* ``c1``: a rigid textured slider (:func:`~femehl.line_jfo_steady.pocket_slider`, a
+* ``c1``: a rigid textured slider (:func:`~femehl.reference.line_jfo_steady.pocket_slider`, a
   cos^2 pocket three films deep, hc = 0.1, beta = 1): rupture entering the pocket and
   reformation inside it;
 * ``c2``: the same slider on a stiff Winkler foundation (k = 100, beta = 10).
@@ -41,8 +41,8 @@ SIZES = (200, 400, 800, 1600)
 
 
 def cases():
-    from femehl.line_jfo_steady import pocket_slider
-    from femehl.scene import Constant, Motion, RampHold, TanhStart
+    from femehl.problem.scene import Constant, Motion, RampHold, TanhStart
+    from femehl.reference.line_jfo_steady import pocket_slider
 
     profile, kinks = pocket_slider()
     pocket = Motion(gap=Constant(0.1), velocity=TanhStart(1.0, 1.0))
@@ -67,14 +67,14 @@ def cases():
 
 
 def reference(model, **kw):
-    from femehl.line_jfo_steady import steady_jfo, steady_reynolds
+    from femehl.reference.line_jfo_steady import steady_jfo, steady_reynolds
 
     return (steady_jfo if model == "jfo" else steady_reynolds)(V=1.0, L=2.0, **kw)
 
 
 def run(scene_kw, model, n):
     import femehl
-    from femehl.line import LineScene
+    from femehl.problem.line import LineScene
 
     sc = LineScene(L=2.0, cavitation=model, **scene_kw)
     t0 = time.perf_counter()
@@ -137,7 +137,7 @@ def main():
         "",
         "femehl's transient line contact (P1 pressure, P0 film, `LineScene(cavitation=...)`) run "
         "to its steady state (t = 300, dt = 0.5) on uniform meshes, against the independent "
-        "exact steady solution `femehl.line_jfo_steady` (quadrature and shooting, its own "
+        "exact steady solution `femehl.reference.line_jfo_steady` (quadrature and shooting, its own "
         "uncertainty <= 2e-9). Load error: relative. Pressure error: the largest over the "
         "nodes, relative to the exact peak. Cavity: femehl's first and last cavitated node "
         "(h is the element size) against the exact reformation and rupture points. Liquid "

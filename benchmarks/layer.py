@@ -7,7 +7,7 @@ this file:
   0.42 over t in [0, 1] (beta = 200, L = 2, no sliding, dt = 0.02, the medium ladder mesh),
   for layer thicknesses h = 0.01 .. 100, against the half space ``HalfSpace(0.3)`` and the
   thin-layer Winkler foundation ``Winkler(k)``, ``k = (1 - nu) / (2 pi (1 - 2 nu) h)``
-  (:func:`femehl.layer_kernel.winkler_limit`): clearance hc, central and minimum film at
+  (:func:`femehl.elastic.layer_kernel.winkler_limit`): clearance hc, central and minimum film at
   t = 1;
 * **set-up**: the time to build the layer's operator against the half space's dense
   build, on the medium and fine ladder meshes, and which form it took (sparse for thin
@@ -69,7 +69,7 @@ def run(substrate):
 
 def limits():
     import femehl
-    from femehl.layer_kernel import winkler_limit
+    from femehl.elastic.layer_kernel import winkler_limit
 
     half = run(femehl.HalfSpace(NU))
     rows = []
@@ -85,8 +85,8 @@ def build_and_accuracy():
     import numpy as np
 
     import femehl
-    from femehl import kernels
-    from femehl.discretizations.fe_disk import FEDisc
+    from femehl.discretize.fe_disk import FEDisc
+    from femehl.elastic import kernels
 
     out = []
     for mesh, hs in BUILD.items():

@@ -22,7 +22,7 @@ The matrix (the paper's sphere, Eq. 12, with the sliding ramp time T free)::
   shared machine, ~100x the FE coarse step): the corners beta in {2, 20000}
   x h0 in {0.01, 1} and the paper case beta = 200, h0 = 0.1, all at T = 0.1,
   dt = 0.05 (5 cases, 60 steps each).
-* relaxation baseline (:mod:`femehl.baseline`, coarse mesh): omega picked by
+* relaxation baseline (:mod:`femehl.reference.baseline`, coarse mesh): omega picked by
   a scan on the paper case (beta = 200, h0 = 0.1, T = 1, dt in {0.01, 0.05}),
   then every (beta, h0, T) with dt in {0.01, 0.05}, each case capped at
   ``--max-case-seconds`` of wall time.
@@ -68,8 +68,8 @@ import numpy as np
 
 import femehl
 from femehl.errors import FemehlError, SolverError
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart
-from femehl.stepping import march
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart
+from femehl.solver.stepping import march
 
 HERE = pathlib.Path(__file__).resolve().parent
 
@@ -188,7 +188,7 @@ def make_case_stepper(solver: str, scene: Scene, mesh: str | None, omega: float 
     if solver == "fd":
         return femehl.make_stepper(scene, "fd", **FD_OPTIONS)
     if solver == "relax":
-        from femehl.baseline import RelaxationStepper
+        from femehl.reference.baseline import RelaxationStepper
 
         return RelaxationStepper(scene, mesh=mesh, omega=omega)
     raise ValueError(solver)
@@ -206,7 +206,7 @@ def run_case(
     max_seconds: float | None = None,
 ) -> dict:
     """Run one case and return its row (a dict with the keys of COLUMNS)."""
-    from femehl.baseline import mass_balance_residual
+    from femehl.reference.baseline import mass_balance_residual
 
     t_end = horizon(T) if t_end is None else t_end
     row = dict(

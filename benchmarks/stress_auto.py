@@ -124,7 +124,7 @@ def write_md(records: list, cap: float) -> None:
         "ran with femehl's own time budget (`max_wall`), which returns the last finished run "
         'with its estimate as "not reached (time budget)" instead of being stopped by the cap.  '
         "A run is accepted at an estimate <= 0.75 tol since 2026-12-04 (commit 3ae6944, "
-        "`femehl.auto.ACCEPT`; <= tol before): the cases run before it whose estimate was above "
+        "`femehl.accuracy.auto.ACCEPT`; <= tol before): the cases run before it whose estimate was above "
         "0.75 tol were run again.",
         "",
         "Outcomes: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())),

@@ -1,4 +1,4 @@
-"""How well the time budget predicts a run: :func:`femehl.auto.predicted_wall` replayed.
+"""How well the time budget predicts a run: :func:`femehl.accuracy.auto.predicted_wall` replayed.
 
 Every automatic sequence recorded in ``auto_runs.jsonl`` (``benchmarks/auto.py``) and
 ``stress_auto.jsonl`` (``benchmarks/stress_auto.py``) keeps the level, cells, steps and wall
@@ -23,7 +23,7 @@ import pathlib
 import numpy as np
 from _machine import header
 
-from femehl.auto import COST_EXPONENT, COST_EXPONENT_RANGE, predicted_wall
+from femehl.accuracy.auto import COST_EXPONENT, COST_EXPONENT_RANGE, predicted_wall
 
 HERE = pathlib.Path(__file__).resolve().parent
 SOURCES = ("auto_runs.jsonl", "stress_auto.jsonl")
@@ -67,7 +67,7 @@ def main() -> None:
         "",
         header("time_budget.py"),
         "",
-        "`femehl.auto.predicted_wall` (cost exponent fitted on the last two runs within "
+        "`femehl.accuracy.auto.predicted_wall` (cost exponent fitted on the last two runs within "
         f"{COST_EXPONENT_RANGE}, {COST_EXPONENT} after one run) against the recorded wall times "
         f"of the automatic sequences in {', '.join(SOURCES)}: predicted / actual, per run after "
         "the first.  No run is made here; "

@@ -34,9 +34,9 @@ HERE = Path(__file__).resolve().parent
 
 def sliding(substrate, mesh="coarse", L=2.0, dt=0.04, t_end=8.0):
     import femehl
-    from femehl.presets import paper_sphere
-    from femehl.scene import Domain
-    from femehl.tribology import sliding_energetics
+    from femehl.problem.presets import paper_sphere
+    from femehl.problem.scene import Domain
+    from femehl.solver.energetics import sliding_energetics
 
     sc = dataclasses.replace(paper_sphere(), substrate=substrate, domain=Domain(L))
     t0 = time.perf_counter()
@@ -58,8 +58,8 @@ def lee_radok(mesh):
     from scipy.integrate import quad
 
     import femehl
-    from femehl.scene import Domain, Fluid, Motion, Scene, Sphere, Table
-    from femehl.theory import hertz_load
+    from femehl.problem.scene import Domain, Fluid, Motion, Scene, Sphere, Table
+    from femehl.reference.theory import hertz_load
 
     tr, F = 0.5, float(hertz_load(1.0))
     sls = femehl.Viscoelastic(G0=1.0, G_inf=0.5, tau=0.5)
@@ -123,7 +123,7 @@ def main():
         "The paper's sphere (beta = 200, L = 2, indentation to hc = -1 then tanh sliding start) "
         "at t = 8 (V = 1 - 2e-6), coarse mesh, BDF2, dt = 0.04; G0 = 1, G_inf = 2/3 (J from 1 to "
         "1.5). De = 2 V tau_c / a with a = 1. Friction and powers in femehl's units "
-        "(femehl.tribology; mu = friction/load sqrt(h_inf/R)). The share is the viscoelastic "
+        "(femehl.solver.energetics; mu = friction/load sqrt(h_inf/R)). The share is the viscoelastic "
         "dissipation's of the friction work f V; 'balance' is (f V - D_film - P) / (f V).",
         "",
         "| tau | De | film centre | film min | load | friction | D_film | P_solid | share | balance |",

@@ -9,7 +9,7 @@ as one more row of each step's linear system (``Motion(mass=..., force=..., hc_d
 with the Reynolds cavitation condition (a liquid cannot hold the suction behind a
 receding ball).  For each approach speed it reports the Stokes number
 ``St = m U / (6 pi eta R^2)``, the coefficient of restitution, the deepest indentation,
-the thinnest film and the collision's energy budget (:mod:`femehl.tribology`).
+the thinnest film and the collision's energy budget (:mod:`femehl.solver.energetics`).
 
 Scales (:class:`femehl.Dimensional`): lengths and films in units of ``h = 50 um`` and
 ``sqrt(R h)``; the reference speed ``V_ss = U`` sets the time scale; the mass, the
@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from femehl.run import run_to_folder
-from femehl.scene import Constant, Dimensional, Domain, Fluid, Motion, Scene, Sphere
+from femehl.output.run import run_to_folder
+from femehl.problem.scene import Constant, Dimensional, Domain, Fluid, Motion, Scene, Sphere
 
 R, G, ETA = 2e-3, 1.0e4, 0.05  # m, Pa, Pa s
 RHO_BALL, RHO_LIQUID, GRAVITY = 7800.0, 1200.0, 9.81  # kg/m^3, m/s^2

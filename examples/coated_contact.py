@@ -26,9 +26,9 @@ import time
 from pathlib import Path
 
 import femehl
-from femehl.presets import paper_sphere
-from femehl.run import run_to_folder
-from femehl.scene import Constant, Motion, Table, TanhStart
+from femehl.output.run import run_to_folder
+from femehl.problem.presets import paper_sphere
+from femehl.problem.scene import Constant, Motion, Table, TanhStart
 
 THICKNESSES = (0.3, 1.0, 3.0)  # coating thickness / sqrt(R h_inf)
 

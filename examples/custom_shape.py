@@ -24,9 +24,9 @@ import time
 
 import numpy as np
 
-from femehl.indenters import Shape
-from femehl.run import run_to_folder
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
+from femehl.output.run import run_to_folder
+from femehl.problem.indenters import Shape
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 
 AMPLITUDE = 0.05  # ripple height, in units of h_inf
 WAVENUMBER = 6.0  # 2 pi / wavelength, in units of 1/sqrt(R h_inf)

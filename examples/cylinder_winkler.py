@@ -6,7 +6,7 @@ Transient sliding of a rigid cylinder on a lubricated Winkler foundation (paper 
 The cylinder (gap x^2/2) is pushed from hc = 0.1 to hc = h_end over 0 <= t <= 1
 (pure squeeze), then slides with V = tanh(t - 1).  At long times the film
 reaches steady sliding, which is compared with the exact steady solution
-(quadrature and shooting, :mod:`femehl.line_steady`).  A PNG of p(x) and d(x)
+(quadrature and shooting, :mod:`femehl.reference.line_steady`).  A PNG of p(x) and d(x)
 with the exact solution overlaid is written to the output folder.
 
 Run::
@@ -23,9 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from femehl.api import solve_line
-from femehl.line import LineScene
-from femehl.line_steady import steady_line
-from femehl.scene import Motion, RampHold, TanhStart
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Motion, RampHold, TanhStart
+from femehl.reference.line_steady import steady_line
 
 
 def main(

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import time
 
-from femehl.indenters import Ellipsoid
-from femehl.run import run_to_folder
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
+from femehl.output.run import run_to_folder
+from femehl.problem.indenters import Ellipsoid
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 
 
 def scene(Rx: float = 0.5, Ry: float = 2.0, h_end: float = -0.5, beta: float = 200.0) -> Scene:

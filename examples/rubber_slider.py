@@ -7,7 +7,7 @@ slid at speeds from 1 mm/s to 0.1 m/s.  At every speed femehl runs the load ramp
 sliding start and the steady sliding (to t = 8 in normalized time), and reports the
 friction coefficient ``mu = friction / load`` with its parts: the film's shear and the
 pressure acting on the inclined ball, and the viscoelastic hysteresis in the rubber
-(:mod:`femehl.tribology`).  The rubber's dissipation peaks where the time a material point
+(:mod:`femehl.solver.energetics`).  The rubber's dissipation peaks where the time a material point
 spends in the contact, ``2 a / V``, is near its retardation time (the Deborah number
 ``De = 2 V tau_c / a``, the distance the rubber travels in one retardation time over
 the contact radius, of order one); slower, the rubber is relaxed and soft, faster, it is
@@ -28,8 +28,8 @@ import time
 from pathlib import Path
 
 import femehl
-from femehl.run import run_to_folder
-from femehl.scene import Dimensional, Domain, Motion, Scene, Sphere, Table, TanhStart
+from femehl.output.run import run_to_folder
+from femehl.problem.scene import Dimensional, Domain, Motion, Scene, Sphere, Table, TanhStart
 
 R, G_INF, G0, TAU = 0.01, 1.0e5, 1.0e6, 0.01  # m, Pa, Pa, s
 ETA, H_INF, NU = 1.0, 1.0e-4, 0.5  # Pa s, m (length scale), -
@@ -62,7 +62,7 @@ def main(out="femehl-out/rubber_slider", speeds=SPEEDS, t_end: float = 8.0, mesh
             store_every=50, overwrite=True, log=lambda *a: None,
         )  # fmt: skip
         load, f, v = float(res.load[-1]), float(res.friction[-1]), float(res.V[-1])
-        scale = math.sqrt(H_INF / R)  # mu = (friction / load) sqrt(h_inf / R), femehl.tribology
+        scale = math.sqrt(H_INF / R)  # mu = (friction / load) sqrt(h_inf / R), femehl.solver.energetics
         row = {
             "V": V,
             "beta": sc.fluid.beta,

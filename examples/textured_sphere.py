@@ -11,7 +11,7 @@ and the run is on the full disk.  The contact (radius about 1) holds some 35 dim
 each needs about 20 elements across, so the mesh is uniformly fine over the contact
 (``r <= R_FINE``) and grows to the rim: about 200,000 elements, where the dense elastic
 operator (320 GB) cannot be held and femehl's ``operator="auto"`` picks the fast one
-(:mod:`femehl.hmatrix`).  The motion is the paper's: indent to hc = -1 over
+(:mod:`femehl.elastic.hmatrix`).  The motion is the paper's: indent to hc = -1 over
 0 <= t <= 1, then slide with V = tanh(t - 1).
 
 Run::
@@ -31,10 +31,10 @@ import time
 
 import numpy as np
 
-from femehl.fe.mesh import estimate_elements, sized_disk
-from femehl.indenters import Shape
-from femehl.run import run_to_folder
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
+from femehl.discretize.mesh import estimate_elements, sized_disk
+from femehl.output.run import run_to_folder
+from femehl.problem.indenters import Shape
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 
 DEPTH = 0.05  # dimple depth, units of h_inf
 DIMPLE_R = 0.12  # dimple radius, units of sqrt(R h_inf)

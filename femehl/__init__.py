@@ -12,10 +12,11 @@ reference).  Quick start::
     result.pressure_at([[0.0, 0.0], [-1.0, 0.0]], t=2.0)
 """
 
-from . import auto, indenters, line, presets
-from .api import make_stepper, methods, solve, solve_line, steps
-from .discretizations import METHODS
-from .errors import (
+from femehl.accuracy import auto
+from femehl.api import make_stepper, methods, solve, solve_line, steps
+from femehl.discretize import METHODS
+from femehl.elastic import Viscoelastic
+from femehl.errors import (
     FemehlError,
     FilmRuptureError,
     MeshError,
@@ -25,9 +26,10 @@ from .errors import (
     SolverError,
     TimeBudgetError,
 )
-from .indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
-from .result import Result
-from .scene import (
+from femehl.output.result import Result
+from femehl.problem import indenters, line, presets
+from femehl.problem.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
+from femehl.problem.scene import (
     Constant,
     Dimensional,
     Domain,
@@ -43,10 +45,9 @@ from .scene import (
     TanhStart,
     Winkler,
 )
-from .stepping import State, march
-from .substrates import Viscoelastic
-from .sweeps import sweep
-from .viscosity import Barus, Roelands
+from femehl.problem.viscosity import Barus, Roelands
+from femehl.solver.stepping import State, march
+from femehl.studies.sweeps import sweep
 
 __version__ = "0.1.0"
 

@@ -1,9 +1,9 @@
 """``femehl.solve``: run a scene with a registered solver and collect a Result.
 
-Methods are discretizations registered in :data:`femehl.discretizations.METHODS`; every
-one is advanced by the same :class:`~femehl.core.stepper.LaggedStepper`, and every run
+Methods are discretizations registered in :data:`femehl.discretize.METHODS`; every
+one is advanced by the same :class:`~femehl.solver.stepper.LaggedStepper`, and every run
 goes through :func:`run_loop`.  The stepping itself is the generator
-:func:`femehl.stepping.march`; :func:`steps` exposes it directly.
+:func:`femehl.solver.stepping.march`; :func:`steps` exposes it directly.
 """
 
 from __future__ import annotations
@@ -11,19 +11,19 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable, Iterator
 
-from .errors import SceneError
-from .loop import _registry, make_stepper, methods, run_loop
-from .result import Result
-from .scene import Scene
-from .stepping import State, march
-from .threads import one_blas_thread
+from femehl.errors import SceneError
+from femehl.output.result import Result
+from femehl.problem.scene import Scene
+from femehl.solver.loop import _registry, make_stepper, methods, run_loop
+from femehl.solver.stepping import State, march
+from femehl.solver.threads import one_blas_thread
 
 __all__ = ["make_stepper", "steps", "solve", "solve_line", "run_loop", "methods"]
 
 
 @one_blas_thread
 def steps(scene: Scene, t_end: float, dt: float, method: str | None = None, **options) -> Iterator[State]:
-    """Generator of States, the initial one first (see :func:`femehl.stepping.march`)."""
+    """Generator of States, the initial one first (see :func:`femehl.solver.stepping.march`)."""
     stepper = make_stepper(scene, method, **options)
     yield from march(stepper, t_end, dt)
 
@@ -42,7 +42,7 @@ def discretization_options(method: str) -> set[str]:
 
 def is_automatic(scene, method: str | None, dt, options) -> bool:
     """True when femehl chooses the discretization: no ``dt`` and none of its options given."""
-    from .auto import LADDERS
+    from femehl.accuracy.auto import LADDERS
 
     method = scene.default_method if method is None else method
     if method not in _registry():
@@ -50,7 +50,7 @@ def is_automatic(scene, method: str | None, dt, options) -> bool:
     return dt is None and method in LADDERS and not (discretization_options(method) & set(options))
 
 
-#: options of the automatic mode only (:func:`femehl.auto.solve_to_tolerance`)
+#: options of the automatic mode only (:func:`femehl.accuracy.auto.solve_to_tolerance`)
 AUTO_ONLY = ("max_elements", "max_wall", "level", "on_run")
 
 
@@ -79,14 +79,14 @@ def solve(
     estimate: bool = True,
     **options,
 ) -> Result:
-    """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.result.Result`.
+    """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.output.result.Result`.
 
     Two modes:
 
     * **automatic** (neither ``dt`` nor a discretization option such as ``mesh`` is
       given): femehl chooses the mesh and the time steps so that the load, central and
       minimum film are within ``tol`` (default 1e-2) at every step
-      (:func:`femehl.auto.solve_to_tolerance`); the result carries the error estimate,
+      (:func:`femehl.accuracy.auto.solve_to_tolerance`); the result carries the error estimate,
       ``result.uncertainty(name, t)``; ``max_wall=`` (seconds) and ``max_elements=``
       (cells) bound what it may spend, ``on_run=`` sees every finished run (pilots too);
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
@@ -94,16 +94,16 @@ def solve(
       ``tol`` is given.  The result carries the space part of the error estimate from a
       companion run twice as coarse with the same steps (FE ladder rungs and ``"fitted"``,
       line contact; about 10-25 % more work; ``estimate=False`` skips it) and, with
-      ``tol``, the time part (:func:`femehl.auto.expert_estimate`).
+      ``tol``, the time part (:func:`femehl.accuracy.auto.expert_estimate`).
 
     Parameters
     ----------
     scene : femehl.Scene
-        The problem (see :mod:`femehl.scene`, :mod:`femehl.presets`).
+        The problem (see :mod:`femehl.problem.scene`, :mod:`femehl.problem.presets`).
     method : str, default: "fe"
-        A key of :data:`femehl.discretizations.METHODS`: "fe" (finite elements, default
+        A key of :data:`femehl.discretize.METHODS`: "fe" (finite elements, default
         for a 2-D scene), "fd" (the paper's polar finite differences, expert mode only)
-        or "line" (line contact, the default for a :class:`femehl.line.LineScene`).
+        or "line" (line contact, the default for a :class:`femehl.problem.line.LineScene`).
     t_end : float, default: 5.0
         End time (normalized).
     dt : float, optional
@@ -111,7 +111,7 @@ def solve(
         first step.
     tol : float, optional
         Automatic mode: the relative accuracy (default 1e-2).  Expert mode: adaptive time
-        steps (:mod:`femehl.core.adaptive`) to this relative local error per unit time;
+        steps (:mod:`femehl.solver.adaptive`) to this relative local error per unit time;
         the scheme is then BDF2 unless given.  ``dt_min``, ``dt_max`` and ``safety`` tune
         the controller.
     store_every : int, default: 1
@@ -126,11 +126,11 @@ def solve(
         Options of the method (FD ``dr``, ``dtheta``; FE ``mesh``; line ``n_elements``)
         and of the stepper (``scheme``, ``linear_solver``, ``terms``, ...).
     """
-    from .core.adaptive import CONTROLS
-    from .stepping import check_run
+    from femehl.solver.adaptive import CONTROLS
+    from femehl.solver.stepping import check_run
 
     if is_automatic(scene, method, dt, options):
-        from .auto import solve_to_tolerance
+        from femehl.accuracy.auto import solve_to_tolerance
 
         return solve_to_tolerance(
             scene,
@@ -150,7 +150,7 @@ def solve(
         options.setdefault("scheme", "bdf2")
     stepper = make_stepper(scene, method, **options)
     result = run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
-    from .auto import companion_run, expert_estimate
+    from femehl.accuracy.auto import companion_run, expert_estimate
 
     companion, ratio = (
         companion_run(scene, stepper.method, options, t_end, dt, tol, controls) if estimate else (None, None)
@@ -171,7 +171,7 @@ def solve_line(
     """Run a line-contact scene: ``solve(scene, method="line", ...)`` with positional times.
 
     ``options`` are the discretization's (``n_elements``, ``grading``, ``fine``, see
-    :class:`femehl.discretizations.fe_line.LineDisc`) and the stepper's (``scheme``).
+    :class:`femehl.discretize.fe_line.LineDisc`) and the stepper's (``scheme``).
     The Result's ``disc.x`` / ``disc.xc`` are the nodes (where ``State.p`` lives) and the
     element centroids (``State.d``, ``State.w``).
     """

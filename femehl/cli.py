@@ -3,7 +3,7 @@
 ``femehl run`` without a file runs the built-in default: the paper's sphere
 (beta = 200, h0 = 0.1) to t = 5 with the FE solver, automatically to 1 %
 (``--tol 0.01``: femehl chooses the mesh and the time steps and reports its error
-estimate; see :mod:`femehl.auto`).  ``--mesh``, ``--n-elements``, ``--dt`` (or
+estimate; see :mod:`femehl.accuracy.auto`).  ``--mesh``, ``--n-elements``, ``--dt`` (or
 ``--method fd``) choose the discretization by hand instead (expert mode).  Options override the file's [run].
 Exit status: 0 done, 2 bad input (nothing written), 3 the run stopped (film
 rupture, singular system) after writing what it had, 130 interrupted (Ctrl-C:
@@ -15,7 +15,7 @@ Options that do not apply to the chosen method are refused.  The run's
 reports go to stderr (logger "femehl"), the figures reached to stdout.
 
 A scene file with ``[indenter] kind = "cylinder"`` is line contact (a
-:class:`femehl.line.LineScene`, method "line"): the same run folder (summary.csv with
+:class:`femehl.problem.line.LineScene`, method "line"): the same run folder (summary.csv with
 y = 0, the field series on the 1-D mesh, checkpoints) and line.png.
 """
 
@@ -28,7 +28,7 @@ import math
 import shlex
 import sys
 
-from .errors import FemehlError, SolverError
+from femehl.errors import FemehlError, SolverError
 
 DEFAULT_OUT = "femehl-out"
 EXIT_DONE, EXIT_BAD_INPUT, EXIT_STOPPED, EXIT_INTERRUPTED = 0, 2, 3, 130
@@ -172,16 +172,16 @@ def _method_options(run: dict, method: str, from_cli: bool) -> dict:
 
 
 def _run(args, argv=()):
-    from . import presets
-    from .output._validation import (
+    from femehl.output._validation import (
         METHOD_FLAGS,
         check_divisions,
         check_method_flags,
         check_resume_overwrite,
         check_step,
     )
-    from .run import run_to_folder
-    from .scenefile import load_scene_file, run_options
+    from femehl.output.run import run_to_folder
+    from femehl.problem import presets
+    from femehl.problem.scenefile import load_scene_file, run_options
 
     dim = None
     if args.scene:
@@ -191,7 +191,7 @@ def _run(args, argv=()):
     else:
         scene, run = presets.paper_sphere(), {}
         name = "paper_sphere"
-    from .line import LineScene
+    from femehl.problem.line import LineScene
 
     is_line = isinstance(scene, LineScene)
     resume, overwrite = check_resume_overwrite(args.resume, args.overwrite)
@@ -245,7 +245,7 @@ def _run(args, argv=()):
             f"femehl: {out} already holds the run to t = {res.t[-1]:g}: nothing to do (give a larger --t-end)"
         )
         return EXIT_DONE
-    from .output.plots import FIGURES, plot_animation
+    from femehl.output.plots import FIGURES, plot_animation
 
     names = [name for name, _ in FIGURES[res.disc.dimension]]
     if args.animate and res.disc.dimension == 2:
@@ -273,7 +273,7 @@ def _plot(args) -> int:
     """``femehl plot history|maps|centreline|animation FOLDER``: the picture, from the folder's files."""
     import time
 
-    from .output.plots import FOLDER_PLOTS, TIMED_PLOTS
+    from femehl.output.plots import FOLDER_PLOTS, TIMED_PLOTS
 
     t0 = time.perf_counter()
     if args.what not in TIMED_PLOTS and args.t is not None:
@@ -300,12 +300,12 @@ def _sweep(args) -> int:
     (the others are written; their keys and errors are printed), 130 interrupted (the
     finished cases stay; the command that goes on is printed).
     """
-    from . import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     if args.args[0] == "plot":
         if len(args.args) != 2:
             raise FemehlError("femehl sweep plot takes one output folder: femehl sweep plot OUT.")
-        from .sweep_plot import plot_master_curves
+        from femehl.studies.sweep_plot import plot_master_curves
 
         png, fits = plot_master_curves(args.args[1], x=args.x)
         for line in fits:
@@ -380,7 +380,7 @@ def _sweep_command(args, *extra) -> str:
 
 def _sweep_interrupted(args, plan) -> int:
     """Ctrl-C during a sweep: how many cases finished (they stay) and the command that goes on."""
-    from . import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     if plan is None:
         print("femehl: interrupted while reading the sweep; nothing was started.", file=sys.stderr)

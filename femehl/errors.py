@@ -47,7 +47,7 @@ class SingularSystemError(SolverError):
 
 
 class RelaxationDivergedError(SolverError):
-    """The relaxation baseline (:mod:`femehl.baseline`) did not converge within a step.
+    """The relaxation baseline (:mod:`femehl.reference.baseline`) did not converge within a step.
 
     ``iterations`` is how many fixed-point iterations were made before giving up.
     """

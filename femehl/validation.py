@@ -7,8 +7,8 @@ the value converted (a float, a checked array) or raises
 Inputs are never mutated: arrays are copied before they are changed.
 
 This module imports nothing from the rest of femehl but :mod:`femehl.errors`, so
-:mod:`femehl.scene` and :mod:`femehl.indenters` can both use it without an import
-cycle.  ``femehl.scene.check_finite`` / ``check_positive`` re-export the functions.
+:mod:`femehl.problem.scene` and :mod:`femehl.problem.indenters` can both use it without an import
+cycle.  ``femehl.problem.scene.check_finite`` / ``check_positive`` re-export the functions.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numbers
 
 import numpy as np
 
-from .errors import SceneError
+from femehl.errors import SceneError
 
 __all__ = [
     "call_time_function",
@@ -38,7 +38,7 @@ def short(value, width: int = 40) -> str:
     return r if len(r) <= width else r[: width - 3] + "..."
 
 
-_short = short  # the historic name in femehl.scene
+_short = short  # the historic name in femehl.problem.scene
 
 
 def _join(message: str, hint: str) -> str:

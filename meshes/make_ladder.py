@@ -4,7 +4,7 @@ Usage (from anywhere)::
 
     python meshes/make_ladder.py
 
-For every name in ``femehl.fe.mesh.LADDER`` (coarse, medium, fine, xfine) this
+For every name in ``femehl.discretize.mesh.LADDER`` (coarse, medium, fine, xfine) this
 meshes the half disk ``y >= 0`` and the full disk of radius ``L = 2`` with
 ``graded_disk(L=2.0, half=..., **LADDER[name])`` (gmsh, deterministic), writes
 them as gmsh 4.1 binary files with meshio, reads each file back through
@@ -24,7 +24,7 @@ import numpy as np
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # the repository root, for an uninstalled femehl
 
-from femehl.fe.mesh import LADDER, _write_msh, graded_disk, load_mesh  # noqa: E402
+from femehl.discretize.mesh import LADDER, _write_msh, graded_disk, load_mesh  # noqa: E402
 
 MAX_BYTES = 3_000_000
 

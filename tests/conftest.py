@@ -28,7 +28,7 @@ def paper_reference():
 
 @pytest.fixture
 def paper_scene():
-    """The paper's sphere case, ``femehl.presets.paper_sphere()`` (beta = 200, h0 = 0.1, L = 2)."""
+    """The paper's sphere case, ``femehl.problem.presets.paper_sphere()`` (beta = 200, h0 = 0.1, L = 2)."""
     return femehl.presets.paper_sphere()
 
 

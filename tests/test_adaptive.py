@@ -1,7 +1,7 @@
-"""Tests of femehl.core.adaptive: adaptive time steps, one linear system per trial step.
+"""Tests of femehl.solver.adaptive: adaptive time steps, one linear system per trial step.
 
 The controller is first checked on a scalar ODE with a known solution, advanced by a fake
-stepper that steps exactly like :class:`~femehl.core.stepper.LaggedStepper` (the same
+stepper that steps exactly like :class:`~femehl.solver.stepper.LaggedStepper` (the same
 variable-step BDF2 coefficients, a backward-Euler step when the state has no history),
 then on real scenes against a fixed-step BDF2 run at dt = 0.0025 on the same mesh, and on
 a scene whose film closes.
@@ -18,10 +18,10 @@ import pytest
 
 import femehl
 from femehl.api import make_stepper, run_loop, solve
-from femehl.core.adaptive import StepController, march_adaptive
 from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
-from femehl.line import LineScene
-from femehl.stepping import SCHEMES, State, film_positive
+from femehl.problem.line import LineScene
+from femehl.solver.adaptive import StepController, march_adaptive
+from femehl.solver.stepping import SCHEMES, State, film_positive
 
 
 # ---- a scalar ODE with a known solution ---------------------------------------------------
@@ -29,7 +29,7 @@ class ScalarODE:
     """``y' = -y + f(t)``, ``f = c + a max(0, t - tb)`` (a kink at ``tb``), ``y(0) = y0``.
 
     The "film" is ``y`` itself (one film point at the origin); ``step`` is the variable-step
-    BDF2 of :data:`femehl.stepping.SCHEMES` (backward Euler without history).
+    BDF2 of :data:`femehl.solver.stepping.SCHEMES` (backward Euler without history).
     """
 
     scheme = SCHEMES["bdf2"]

@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl.auto import QUANTITIES, solve_to_tolerance, time_tolerance
-from femehl.line import LineScene
+from femehl.accuracy.auto import QUANTITIES, solve_to_tolerance, time_tolerance
+from femehl.problem.line import LineScene
 
 REFERENCE = pathlib.Path(__file__).parents[1] / "benchmarks" / "auto_reference.json"
 
@@ -176,7 +176,7 @@ def test_an_estimate_near_tol_is_not_accepted(monkeypatch):
     """A run is accepted at an estimate <= ACCEPT * tol, not <= tol (the margin for the
     estimate's measured shortfall, femehl.auto.ACCEPT): with the third run's estimate at
     0.9 tol a fourth, finer run is made, and its 0.7 tol is the answer."""
-    import femehl.auto as auto
+    import femehl.accuracy.auto as auto
 
     real, tol = auto.estimate, 1e-2
     worst = iter([5 * tol, 0.9 * tol, 0.7 * tol])  # the pairs ending at the 2nd, 3rd and 4th run
@@ -213,7 +213,7 @@ def test_budget_buys_one_last_finer_run(caplog):
     """The level the estimate asks for exceeds the budget: the finest level within it is run
     (at least BUDGET_RATIO finer than the last), then the sequence stops, estimated against
     the last run at their actual ratio.  Below BUDGET_RATIO: no extra run."""
-    from femehl.auto import BUDGET_RATIO, LADDERS
+    from femehl.accuracy.auto import BUDGET_RATIO, LADDERS
 
     scene = femehl.presets.paper_sphere()
     cells = LADDERS["fe"].cells
@@ -263,7 +263,7 @@ def test_cli_default_is_automatic(tmp_path, capsys):
 
 def test_automatic_run_resumes(tmp_path):
     """A finished automatic run continued to a later t_end: same level, estimate rebuilt."""
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     scene = LineScene()
     out = tmp_path / "run"
@@ -283,7 +283,7 @@ def _closed(t, where, reason="closes", d_min=0.0, film0=0.1):
 
 def test_a_closing_on_a_pilot_is_retried_finer():
     """Level 2 (a pilot) closes: not confirmed, the next level decides."""
-    from femehl.auto import _closing_confirmed
+    from femehl.accuracy.auto import _closing_confirmed
 
     first = _closing_confirmed(None, _closed(1.70, (-0.74, 0.0)), 2.0, 3.0)
     assert first.level == 2.0
@@ -293,7 +293,7 @@ def test_a_closing_on_a_pilot_is_retried_finer():
 
 
 def test_a_closing_confirmed_by_two_levels_is_raised():
-    from femehl.auto import _closing_confirmed
+    from femehl.accuracy.auto import _closing_confirmed
 
     earlier = _closing_confirmed(None, _closed(2.312, (-1.217, 0.129)), 1.0, 3.0)
     # a step floor with the film at 9e-6 of h0 = 0.01 (9e-4 of it) at the same place: closed
@@ -309,7 +309,7 @@ def test_cell_budget_follows_the_substrate():
     fast operator (half spaces, a viscoelastic half space) get the larger budgets, a
     dense-only one (a layer, a viscoelastic layer) the dense budget; an explicit budget is
     kept; a bad one is refused by name."""
-    from femehl.auto import FAST_MAX_ELEMENTS, LOCAL_MAX_ELEMENTS, MAX_ELEMENTS, cell_budget
+    from femehl.accuracy.auto import FAST_MAX_ELEMENTS, LOCAL_MAX_ELEMENTS, MAX_ELEMENTS, cell_budget
 
     paper = femehl.presets.paper_sphere()
     assert MAX_ELEMENTS < FAST_MAX_ELEMENTS
@@ -332,7 +332,7 @@ def test_cell_budget_follows_the_substrate():
 
 # ---- the time budget ---------------------------------------------------------------------
 class _Run:
-    """What :func:`femehl.auto.predicted_wall` reads of a finished run."""
+    """What :func:`femehl.accuracy.auto.predicted_wall` reads of a finished run."""
 
     def __init__(self, level, elements, steps, wall):
         self.info = {"level": level, "elements": elements, "wall": wall}
@@ -343,7 +343,7 @@ def test_predicted_wall_follows_the_fitted_cost():
     """Two runs whose cost per step grows like cells^1.6 (inside the range): the next one,
     at half the level, is predicted with that exponent and twice the steps; outside the
     range the exponent is clipped; with one run it is COST_EXPONENT."""
-    from femehl.auto import COST_EXPONENT, COST_EXPONENT_RANGE, predicted_wall
+    from femehl.accuracy.auto import COST_EXPONENT, COST_EXPONENT_RANGE, predicted_wall
 
     a = _Run(2.0, 1000, 100, 100 * 1e-3)
     b = _Run(1.0, 4000, 200, 200 * 1e-3 * 4.0**1.6)
@@ -357,7 +357,7 @@ def test_predicted_wall_follows_the_fitted_cost():
 
 
 def test_max_wall_is_checked():
-    from femehl.auto import check_max_wall
+    from femehl.accuracy.auto import check_max_wall
 
     assert check_max_wall(None) is None and check_max_wall(60) == 60.0
     scene = femehl.presets.paper_sphere()
@@ -388,7 +388,7 @@ def test_time_budget_stops_with_the_last_finished_run(monkeypatch, caplog):
     """A third run predicted to overrun what is left (and no level >= BUDGET_RATIO finer
     predicted to fit): the sequence stops after two runs, and the answer is the second
     with its pair estimate, ``stopped = "time budget"``, and a warning."""
-    import femehl.auto as auto
+    import femehl.accuracy.auto as auto
 
     real = auto.predicted_wall
     monkeypatch.setattr(auto, "predicted_wall", lambda runs, cells, level: 1e9 if len(runs) >= 2 else 0.0)
@@ -434,7 +434,7 @@ def test_time_budget_is_asked_again_after_a_fitted_run(monkeypatch):
     cheaper than predicted leaves time, and the next level is predicted again.  Here the
     prediction lets levels >= 1.5 fit after two runs, >= 1.1 after three, none after four:
     runs at 4, 2, the finest level >= 1.5 and then the finest >= 1.1."""
-    import femehl.auto as auto
+    import femehl.accuracy.auto as auto
 
     floor = {1: 0.0, 2: 1.5, 3: 1.1}
     monkeypatch.setattr(
@@ -450,7 +450,7 @@ def test_the_budget_that_binds_is_named(monkeypatch):
     """The level the estimate asks for is over the cell budget, but the time allows only a
     coarser level than the cells would: that run is the time budget's (named so, and the
     prediction is asked again after it), not the cell budget's last run."""
-    import femehl.auto as auto
+    import femehl.accuracy.auto as auto
 
     scene = femehl.presets.paper_sphere()
     cells = auto.LADDERS["fe"].cells_of(scene, 0.1)

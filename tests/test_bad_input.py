@@ -26,9 +26,9 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import femehl
+from femehl.discretize.mesh import load_mesh
 from femehl.errors import FemehlError, MeshError, SceneError, SceneFileError
-from femehl.fe.mesh import load_mesh
-from femehl.scene import (
+from femehl.problem.scene import (
     Domain,
     Fluid,
     HalfSpace,
@@ -41,8 +41,8 @@ from femehl.scene import (
     TanhStart,
     Winkler,
 )
-from femehl.scenefile import load_scene_file, run_options
-from femehl.stepping import check_run
+from femehl.problem.scenefile import load_scene_file, run_options
+from femehl.solver.stepping import check_run
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: Warnings (overflow in a user's extreme value, a singular-matrix warning before the solver
@@ -353,7 +353,7 @@ EVERY_KEY = {
     "fluid": ["beta", "cavitation", "viscosity"],
     "fluid.viscosity": ["kind", "alpha", "p_r", "Z"],
     "domain": ["L"],
-    "run": sorted(femehl.scenefile.RUN_KEYS),
+    "run": sorted(femehl.problem.scenefile.RUN_KEYS),
     "motion": ["mass", "force", "hc_dot0", "load", "gap", "velocity"],
     "motion.gap": ["kind", "h0", "h_end", "t1", "value", "times", "values"],
     "motion.velocity": ["kind", "t1", "T", "V_ss", "value", "times", "values"],

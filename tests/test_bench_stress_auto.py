@@ -1,7 +1,7 @@
 """``benchmarks/stress_auto.py``: a capped case keeps the levels it finished.
 
 The driver kills a worker at the cap and reads femehl's per-level log lines (the format of
-``femehl.auto``'s "auto: level ..." message) from what the worker wrote to stderr.  Here a
+``femehl.accuracy.auto``'s "auto: level ..." message) from what the worker wrote to stderr.  Here a
 worker that finishes two levels and then sleeps past a 3 s cap, so the record must name
 exactly those two levels.
 """
@@ -31,7 +31,7 @@ def test_levels_are_read_from_the_log(bench, caplog):
     import logging
 
     import femehl
-    from femehl.line import LineScene
+    from femehl.problem.line import LineScene
 
     with caplog.at_level(logging.INFO, logger="femehl"):
         res = femehl.solve(LineScene(), t_end=0.5, tol=3e-2, store_every=0)

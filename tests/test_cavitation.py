@@ -20,8 +20,8 @@ from scipy.optimize import brentq
 
 import femehl
 from femehl.errors import SceneError
-from femehl.line import LineScene
-from femehl.scene import Constant, Fluid, Motion
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Constant, Fluid, Motion
 
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
@@ -102,7 +102,7 @@ def test_paper_case_with_cavitation():
 
 
 def test_resume_keeps_the_cavitated_set(tmp_path):
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     sc = LineScene(
         k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L, cavitation="reynolds"
@@ -120,7 +120,7 @@ def test_bad_cavitation_and_fd_and_toml(tmp_path):
     sc = dataclasses.replace(femehl.presets.paper_sphere(), fluid=Fluid(200.0, cavitation="reynolds"))
     with pytest.raises(SceneError, match="method='fe'"):
         femehl.solve(sc, t_end=0.1, dt=0.05, method="fd", dr=0.1, dtheta=math.pi / 12)
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     f = tmp_path / "s.toml"
@@ -232,13 +232,13 @@ def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
         LineScene(
             motion=Motion(gap=Constant(HC), velocity=Constant(V)), load=0.5, cavitation="half-sommerfeld"
         )
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     toml = tmp_path / "s.toml"
     toml.write_text(src.replace("[fluid]\n", '[fluid]\ncavitation = "half-sommerfeld"\n'))
     assert load_scene_file(toml)[0].cavitation == "half-sommerfeld"
-    from femehl.sweeps import SweepError, plan_sweep
+    from femehl.studies.sweeps import SweepError, plan_sweep
 
     run = {"t_end": 0.2, "dt": 0.1, "mesh": "coarse"}
     plan = plan_sweep(None, {"fluid.cavitation": [None, "reynolds", "half-sommerfeld"]}, run=run)
@@ -278,9 +278,9 @@ def test_summary_columns_series_and_restart(tmp_path):
     """summary.csv: full Sommerfeld keeps exactly its columns; a condition adds its own
     (the Result's arrays); the half-Sommerfeld series is labelled; a resumed run writes
     the same table as the whole run."""
+    from femehl.output.run import run_to_folder
     from femehl.output.series import field_value
     from femehl.output.table import COLUMNS, read_summary
-    from femehl.run import run_to_folder
 
     base = dict(k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L)
     opts = dict(dt=0.05, n_elements=100, linear_solver="lu", log=lambda *a: None, checkpoint_every=5)

@@ -21,12 +21,12 @@ import numpy as np
 import pytest
 
 from femehl.api import make_stepper, run_loop
-from femehl.core.linsolve import PermutedLU, TwoLevel, nested_dissection
-from femehl.discretizations.fe_disk import FEDisc
-from femehl.fe.coarse import coarse_prolongation, node_sizes
-from femehl.fe.fitted import fitted_disk
-from femehl.hmatrix import FastCompliance
-from femehl.presets import paper_sphere
+from femehl.discretize.coarse import coarse_prolongation, node_sizes
+from femehl.discretize.fe_disk import FEDisc
+from femehl.discretize.fitted import fitted_disk
+from femehl.elastic.hmatrix import FastCompliance
+from femehl.problem.presets import paper_sphere
+from femehl.solver.linsolve import PermutedLU, TwoLevel, nested_dissection
 
 
 @pytest.fixture(scope="module")

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from femehl.cli import main as cli_main
-from femehl.scene import Dimensional
-from femehl.scenefile import load_scene_file
+from femehl.problem.scene import Dimensional
+from femehl.problem.scenefile import load_scene_file
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 HERTZ_LOAD = 4.0 / (3.0 * math.pi)
@@ -97,7 +97,7 @@ def check_paper_figures(mod, tmp_path):
 def check_rubber_slider(mod, tmp_path):
     """Three speeds (shortened to t = 6, V = 1 - 1e-4): the rubber's hysteresis is largest at
     De ~ 1, the middle speed (elastic in both limits), and the two dissipations add up to
-    the friction work (steady sliding, femehl.tribology) to 1e-3."""
+    the friction work (steady sliding, femehl.solver.energetics) to 1e-3."""
     rows = mod.main(out=tmp_path, speeds=(1e-3, 1e-2, 1e-1), t_end=6.0, dt=0.05)
     rubber = [r["mu_rubber"] for r in rows]
     assert rubber[1] > max(rubber[0], rubber[2]) and min(rubber) > 0  # the peak near De = 1

@@ -19,12 +19,12 @@ import pytest
 from scipy.special import ellipe
 
 import femehl
-from femehl.discretizations.fe_disk import FEDisc
+from femehl.discretize.fe_disk import FEDisc
+from femehl.discretize.fitted import fitted_disk
+from femehl.elastic.hmatrix import FastCompliance, FastOptions, H2Operator, order_for, sampled_error
+from femehl.elastic.kernels import triangle_influence
 from femehl.errors import SceneError
-from femehl.fe.fitted import fitted_disk
-from femehl.hmatrix import FastCompliance, FastOptions, H2Operator, order_for, sampled_error
-from femehl.kernels import triangle_influence
-from femehl.presets import paper_sphere
+from femehl.problem.presets import paper_sphere
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -212,7 +212,7 @@ def test_short_run_agrees_with_dense(sphere):
 
 def test_auto_picks_by_size(sphere):
     """ "auto" is dense below the crossover and fast above it (no operator is built here)."""
-    from femehl.discretizations import fe_disk
+    from femehl.discretize import fe_disk
 
     small = FEDisc(sphere, mesh="coarse")
     large = FEDisc(sphere, mesh=fitted_disk(sphere, 5.0, 0.45))

@@ -1,4 +1,4 @@
-"""Tests of the paper-faithful polar finite-difference solver (femehl.fd).
+"""Tests of the paper-faithful polar finite-difference solver (femehl.discretize.fd_polar).
 
 Expected values come from analytic limits (rigid-substrate squeeze film,
 Reynolds' sphere-plane law, Hertz), from convergence under refinement, and
@@ -17,8 +17,8 @@ import pytest
 from femehl import api
 from femehl.api import make_stepper
 from femehl.errors import SceneError
-from femehl.presets import paper_sphere
-from femehl.scene import (
+from femehl.problem.presets import paper_sphere
+from femehl.problem.scene import (
     Dimensional,
     Domain,
     Fluid,
@@ -491,7 +491,7 @@ def test_unknown_method():
 
 
 def test_fd_rejects_indenter_not_symmetric_in_y():
-    from femehl.indenters import Shape
+    from femehl.problem.indenters import Shape
 
     shape = Shape(lambda x, y: 0.5 * (x * x + y * y) + 0.3 * np.maximum(y, 0.0) ** 2, symmetric_y=False)
     sc = Scene(

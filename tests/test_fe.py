@@ -10,8 +10,8 @@ import pytest
 import scipy.sparse as sp
 
 import femehl
-from femehl.core.terms import StepContext
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Rigid, Scene, Sphere, Winkler
+from femehl.solver.terms import StepContext
 
 
 def rigid_scene(beta=1.0, V=0.0):

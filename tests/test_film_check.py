@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl.kernels import triangle_influence
+from femehl.elastic.kernels import triangle_influence
 
 
 def test_tip_film_closing_between_centroids_stops_the_run():

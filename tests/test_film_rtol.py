@@ -1,4 +1,4 @@
-"""The Krylov residual follows a thinning film (femehl.core.linsolve.film_rtol_scale).
+"""The Krylov residual follows a thinning film (femehl.solver.linsolve.film_rtol_scale).
 
 The solve's error moves the film by about ``rtol`` times the deflection whatever the film,
 so a film much thinner than the deflection carries a relative error that grows as it
@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import femehl
-import femehl.core.stepper as stepper_module
+import femehl.solver.stepper as stepper_module
 from femehl import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart
-from femehl.core import linsolve
-from femehl.core.linsolve import FILM_RTOL_FLOOR, FILM_RTOL_REF, film_rtol_scale
+from femehl.solver import linsolve
+from femehl.solver.linsolve import FILM_RTOL_FLOOR, FILM_RTOL_REF, film_rtol_scale
 
 
 @pytest.mark.parametrize(

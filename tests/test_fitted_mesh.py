@@ -1,4 +1,4 @@
-"""Tests of femehl.fe.fitted: contact extents, scene-fitted meshes and their cache."""
+"""Tests of femehl.discretize.fitted: contact extents, scene-fitted meshes and their cache."""
 
 from __future__ import annotations
 
@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 import femehl
+from femehl.discretize.fitted import contact_extent, fitted_disk, fitted_sizes, hertz_ellipse
+from femehl.discretize.mesh import areas, load_mesh
 from femehl.errors import MeshError, SceneError
-from femehl.fe import fitted as F
-from femehl.fe.fitted import contact_extent, fitted_disk, fitted_sizes, hertz_ellipse
-from femehl.fe.mesh import areas, load_mesh
-from femehl.indenters import Ellipsoid, FlatPunch, Shape, Sphere
-from femehl.scene import Domain, Motion, RampHold, Scene, TanhStart, Winkler
+from femehl.discretize import fitted as F
+from femehl.problem.indenters import Ellipsoid, FlatPunch, Shape, Sphere
+from femehl.problem.scene import Domain, Motion, RampHold, Scene, TanhStart, Winkler
 
 #: Elements crossed along each contact axis (the contact width 2a) that a fitted
 #: mesh at level 1 must have.  The medium ladder crosses the ellipsoid's short axis
@@ -311,7 +311,7 @@ def test_load_mesh_names_the_fitted_fix():
 
 def test_heightmap_extent():
     """A sampled sphere (HeightMap) goes through the Sneddon route: a = 1 to 1 %."""
-    from femehl.indenters import HeightMap
+    from femehl.problem.indenters import HeightMap
 
     g = np.linspace(-3.0, 3.0, 241)
     X, Y = np.meshgrid(g, g, indexing="ij")

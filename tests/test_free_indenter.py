@@ -16,9 +16,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import femehl
+from femehl.elastic import Rigid
 from femehl.errors import SceneError
-from femehl.scene import Constant, Domain, Fluid, Motion, Scene
-from femehl.substrates import Rigid
+from femehl.problem.scene import Constant, Domain, Fluid, Motion, Scene
 
 BETA, L, H0 = 1.0, 2.0, 0.3
 
@@ -93,7 +93,7 @@ def test_a_small_mass_is_the_imposed_load():
 def test_resume_continues_the_motion(tmp_path):
     """A run resumed from its checkpoint goes on as if never stopped (velocity and its
     history restored)."""
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     sc = Scene(
         substrate=Rigid(),
@@ -148,7 +148,7 @@ def test_scenes_without_a_mass_describe_as_before():
 def test_toml(tmp_path):
     import pathlib
 
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     f = tmp_path / "s.toml"
@@ -164,7 +164,7 @@ def test_toml(tmp_path):
 
 
 def test_collision_energy_budget_closes_to_the_time_error():
-    """Kinetic + elastic energy + twice the film's dissipated work (femehl.tribology's unit)
+    """Kinetic + elastic energy + twice the film's dissipated work (femehl.solver.energetics's unit)
     stay at the thrown sphere's kinetic energy: the budget is an identity of the continuous
     problem, so its drift is BDF2's time error (measured 6.4 % and 1.7 % of the initial energy
     at dt = 0.02 and 0.01, ratio 3.9: second order)."""
@@ -197,7 +197,7 @@ def test_bad_si_free_indenter(tmp_path, extra, words):
     import pathlib
 
     from femehl.errors import SceneFileError
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "ball_drop.toml").read_text()
     start, end = src.index("mass ="), src.index("sliding = false\n") + len("sliding = false\n")

@@ -42,7 +42,7 @@ RUN_TOML = '[run]\nt_end = 0.1\ndt = 0.05\nmesh = "coarse"\nstore_every = 2\n'
 def run_folder(tmp_path_factory):
     """The paper case on the coarse mesh to t = 0.8, fields stored at 0, 0.2, ..., 0.8."""
     folder = tmp_path_factory.mktemp("run")
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     run_to_folder(
         femehl.presets.paper_sphere(),
@@ -153,7 +153,7 @@ def test_wrong_types_in_the_sweep_file_are_femehls_errors(tmp_path, capsys, body
     ],
 )
 def test_bad_run_options_are_refused_before_the_cluster_starts(tmp_path, monkeypatch, run, words):
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     def no_cluster(*a, **k):
         raise AssertionError("the cluster was started for a sweep whose cases cannot run")
@@ -167,7 +167,7 @@ def test_bad_run_options_are_refused_before_the_cluster_starts(tmp_path, monkeyp
 
 
 def test_cli_all_bad_cases_exit_2_naming_them(tmp_path, capsys, monkeypatch):
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     monkeypatch.setattr(sw, "_client", lambda *a, **k: pytest.fail("cluster started"))
     body = '[[cases]]\n"fluid.beta" = 50.0\n[[cases]]\n"fluid.beta" = 200.0\n[run]\nt_end = -2.0\n'
@@ -189,7 +189,7 @@ def test_cli_failed_cases_exit_3_naming_them_and_the_others_stay(tmp_path, capsy
     cap = capsys.readouterr()
     assert "1 of 2 cases did not finish" in cap.err and "fluid.beta = 60.0" in cap.err
     assert "no-such-mesh" in cap.err and "--retry-failed" in cap.err
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     table = sw.read_results(tmp_path / "out")
     st = table.drop_duplicates("case").set_index("fluid.beta")["status"]
@@ -200,7 +200,7 @@ def test_cli_failed_cases_exit_3_naming_them_and_the_others_stay(tmp_path, capsy
 
 # ---- 3. workers = 0 -----------------------------------------------------------------------
 def test_workers_zero_is_refused_everywhere(tmp_path, capsys, monkeypatch):
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     monkeypatch.setattr(sw, "_client", lambda *a, **k: pytest.fail("cluster started"))
     with pytest.raises(sw.SweepError, match="workers must be a positive integer") as info:
@@ -221,7 +221,7 @@ def test_workers_zero_is_refused_everywhere(tmp_path, capsys, monkeypatch):
 
 # ---- 4. a grid too large to expand --------------------------------------------------------
 def test_a_huge_grid_is_refused_before_it_is_expanded():
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     grid = {n: {"linspace": [1.0, 2.0], "num": 10_000} for n in ("fluid.beta", "domain.L")}
     t0 = time.perf_counter()
@@ -250,7 +250,7 @@ def test_ctrl_c_says_what_finished_and_how_to_go_on(tmp_path, capsys, monkeypatc
     command; running that command finishes the sweep without running the first again."""
     import distributed
 
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     real = distributed.as_completed
 
@@ -321,7 +321,7 @@ def test_rerunning_a_sweep_folder_never_loses_or_mixes(scheduler):
     from hypothesis import HealthCheck, given, settings
     from hypothesis import strategies as st
 
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     betas = (40.0, 50.0, 60.0)
     plan0 = sw.plan_sweep(None, cases=[{"fluid.beta": b} for b in betas], run=RUN)
@@ -489,7 +489,7 @@ def test_sweep_plot_of_damaged_or_missing_folders(tmp_path, capsys):
 
 
 def test_a_sweep_out_that_is_a_file(tmp_path):
-    from femehl import sweeps as sw
+    from femehl.studies import sweeps as sw
 
     pytest.importorskip("distributed")
     (tmp_path / "f").write_text("mine")

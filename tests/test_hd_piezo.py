@@ -1,4 +1,4 @@
-"""Hamrock-Dowson piezoviscous-elastic films and the regime parameters (femehl.theory).
+"""Hamrock-Dowson piezoviscous-elastic films and the regime parameters (femehl.reference.theory).
 
 The films are evaluated here in SI units straight from the published form
 ``H = A U^a G^g W^b (1 - C exp(-D k))`` (``U = eta0 u/(E' Rx)``, ``G = alpha* E'``,
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl import theory
 from femehl.errors import SceneError
+from femehl.reference import theory
 
 CENTRAL = (2.69, 0.67, 0.53, -0.067, 0.61, 0.73)
 MINIMUM = (3.63, 0.68, 0.49, -0.073, 1.0, 0.68)

@@ -28,8 +28,8 @@ import pytest
 
 import femehl
 from femehl.errors import SceneError
-from femehl.line import LineScene
-from femehl.scene import Constant, Fluid, Motion, RampHold
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Constant, Fluid, Motion, RampHold
 
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
@@ -162,7 +162,7 @@ def test_fd_refuses_jfo_and_toml(tmp_path):
     sc = dataclasses.replace(femehl.presets.paper_sphere(), fluid=Fluid(200.0, cavitation="jfo"))
     with pytest.raises(SceneError, match="method='fe'"):
         femehl.solve(sc, t_end=0.1, dt=0.05, method="fd", dr=0.1, dtheta=math.pi / 12)
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     f = tmp_path / "s.toml"
@@ -179,8 +179,8 @@ def test_imposed_load_is_met():
 
 
 def test_resume_series_and_columns(tmp_path):
+    from femehl.output.run import run_to_folder
     from femehl.output.table import COLUMNS, read_summary
-    from femehl.run import run_to_folder
 
     sc = _TwoConstrictions(
         k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L, cavitation="jfo"
@@ -193,7 +193,7 @@ def test_resume_series_and_columns(tmp_path):
     assert np.array_equal(resumed.final.own["gas"], whole.final.own["gas"])
     a, b = (read_summary(tmp_path / s / "summary.csv") for s in "ab")
     extra = tuple(c for c in a if not c.startswith("err_"))[len(COLUMNS) :]
-    assert extra == femehl.cavitation.JFOCavitation.columns
+    assert extra == femehl.solver.cavitation.JFOCavitation.columns
     for c in extra:
         assert np.array_equal(a[c], b[c]), c
     import meshio
@@ -209,12 +209,12 @@ def test_resume_series_and_columns(tmp_path):
 def test_pocket_slider_against_the_exact_steady_solution():
     """A textured slider (a cos^2 pocket three films deep) on a stiff Winkler foundation:
     the film ruptures entering the pocket and reforms in its narrowing half.  Against the
-    independent exact steady solution (:mod:`femehl.line_jfo_steady`, quadrature and
+    independent exact steady solution (:mod:`femehl.reference.line_jfo_steady`, quadrature and
     shooting with the JFO jump at reformation): measured on 400 / 800 / 1600 uniform
     elements the load is off by 3.4e-5 / 6.4e-6 / -1.1e-6 and the pressure by 1.1e-4 /
     2.6e-5 / 1.1e-5 of its peak; the tolerances below are about 3 x the 400-element figures.
     The Reynolds condition reforms elsewhere (at -0.574 instead of -0.828) with 14 % more load."""
-    from femehl.line_jfo_steady import pocket_slider, steady_jfo
+    from femehl.reference.line_jfo_steady import pocket_slider, steady_jfo
 
     profile, kinks = pocket_slider()
     ref = steady_jfo(profile, 0.1, V=1.0, beta=10.0, k=100.0, L=2.0, kinks=kinks)
@@ -223,7 +223,7 @@ def test_pocket_slider_against_the_exact_steady_solution():
         k=100.0,
         beta=10.0,
         profile=profile,
-        motion=Motion(gap=Constant(0.1), velocity=femehl.scene.TanhStart(1.0, 1.0)),
+        motion=Motion(gap=Constant(0.1), velocity=femehl.problem.scene.TanhStart(1.0, 1.0)),
         cavitation="jfo",
     )
     res = femehl.solve(sc, t_end=300.0, dt=0.5, n_elements=400, grading="uniform", estimate=False)
@@ -261,7 +261,7 @@ def test_free_indenter_and_the_tracked_elastic_products():
     from femehl.api import make_stepper
 
     motion = femehl.Motion(
-        gap=0.1, velocity=femehl.scene.TanhStart(1.0, 1.0), mass=1.0, force=0.4, hc_dot0=0.0
+        gap=0.1, velocity=femehl.problem.scene.TanhStart(1.0, 1.0), mass=1.0, force=0.4, hc_dot0=0.0
     )
     paper = femehl.presets.paper_sphere()
     sc = dataclasses.replace(paper, fluid=Fluid(200.0, cavitation="jfo"), motion=motion)

@@ -1,4 +1,4 @@
-"""Tests of femehl.kernels: the exact integral I(A, T) = int_T dA'/|A - x'|.
+"""Tests of femehl.elastic.kernels: the exact integral I(A, T) = int_T dA'/|A - x'|.
 
 Every expected value below comes from an independent computation:
 
@@ -30,9 +30,15 @@ from scipy import integrate
 from scipy.spatial import Delaunay
 from scipy.special import ellipe
 
-from femehl.fd.grid import PolarGrid
-from femehl.fe.mesh import load_mesh
-from femehl.kernels import edge_terms, influence_matrix, mesh_edges, quad_influence, triangle_influence
+from femehl.discretize.mesh import load_mesh
+from femehl.discretize.polar_grid import PolarGrid
+from femehl.elastic.kernels import (
+    edge_terms,
+    influence_matrix,
+    mesh_edges,
+    quad_influence,
+    triangle_influence,
+)
 
 # ---------------------------------------------------------------------------
 # independent reference computations

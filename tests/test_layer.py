@@ -23,10 +23,9 @@ import scipy.linalg as sl
 import scipy.special as ss
 
 import femehl
-from femehl import kernels
-from femehl.discretizations.fe_disk import FEDisc
-from femehl.errors import SceneError, SceneFileError
-from femehl.layer_kernel import (
+from femehl.discretize.fe_disk import FEDisc
+from femehl.elastic import kernels
+from femehl.elastic.layer_kernel import (
     LayerKernel,
     hankel_table,
     layer_factor,
@@ -34,7 +33,8 @@ from femehl.layer_kernel import (
     thin_layer_factor,
     winkler_limit,
 )
-from femehl.scenefile import scene_from_mapping
+from femehl.errors import SceneError, SceneFileError
+from femehl.problem.scenefile import scene_from_mapping
 
 
 # ---- 1. K(t) against the boundary-value problem -----------------------------------------
@@ -292,7 +292,7 @@ def test_fd_operator_matches_its_half_space_for_thick_layers():
     import math as m
 
     sc = femehl.presets.paper_sphere()
-    from femehl.discretizations.fd_polar import FDDisc
+    from femehl.discretize.fd_polar import FDDisc
 
     fd = FDDisc(sc, dr=0.2, dtheta=m.pi / 6)
     C0 = fd.boussinesq()
@@ -376,8 +376,8 @@ def test_refused_combinations(tmp_path):
             {"indenter": {"kind": "cylinder"}, "substrate": {"kind": "layer", "thickness": 0.5}},
             tmp_path / "c.toml",
         )
-    from femehl.discretizations.fe_line import LineDisc
-    from femehl.line import LineScene
+    from femehl.discretize.fe_line import LineDisc
+    from femehl.problem.line import LineScene
 
     with pytest.raises(SceneError, match="method='fe'"):
         femehl.Layer(0.5).compliance_operator(LineDisc(LineScene(k=1.0)))
@@ -386,8 +386,8 @@ def test_refused_combinations(tmp_path):
 
 
 def test_exported():
-    assert femehl.Layer is femehl.substrates.Layer
-    assert femehl.substrates.SUBSTRATES["layer"] is femehl.Layer
+    assert femehl.Layer is femehl.elastic.Layer
+    assert femehl.elastic.SUBSTRATES["layer"] is femehl.Layer
 
 
 def test_grid_smooth_part_matches_direct(coarse):

@@ -1,4 +1,5 @@
-"""Tests of femehl.line (cylinder on a Winkler foundation) against femehl.line_steady and exact limits.
+"""Tests of femehl.line (cylinder on a Winkler foundation) against
+femehl.reference.line_steady and exact limits.
 
 Measured figures these tolerances come from (k = 1, beta = 10, hc = -0.5, L = 2,
 graded mesh ratio 3, dt = 0.05, t = 15; errors of the final state):
@@ -26,13 +27,13 @@ import pytest
 import scipy.sparse as sp
 
 from femehl.api import make_stepper, solve_line
-from femehl.core.terms import StepContext
 from femehl.errors import SceneError
-from femehl.line import LineScene, line_nodes
-from femehl.line_steady import steady_line, steady_line_load
-from femehl.result import Result
-from femehl.scene import Constant, Motion, RampHold, Table, TanhStart
-from femehl.stepping import State
+from femehl.output.result import Result
+from femehl.problem.line import LineScene, line_nodes
+from femehl.problem.scene import Constant, Motion, RampHold, Table, TanhStart
+from femehl.reference.line_steady import steady_line, steady_line_load
+from femehl.solver.stepping import State
+from femehl.solver.terms import StepContext
 
 K, BETA, HC, L = 1.0, 10.0, -0.5, 2.0
 

@@ -1,4 +1,4 @@
-"""Line contact in TOML scene files and through ``femehl run`` (femehl.scenefile, femehl.cli)."""
+"""Line contact in TOML scene files and through ``femehl run`` (femehl.problem.scenefile, femehl.cli)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import pytest
 from femehl.api import solve_line
 from femehl.cli import main
 from femehl.errors import SceneFileError
-from femehl.line import LineScene
 from femehl.output.table import COLUMNS, ERROR_COLUMNS
-from femehl.scene import Motion, RampHold, TanhStart
-from femehl.scenefile import load_scene_file
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Motion, RampHold, TanhStart
+from femehl.problem.scenefile import load_scene_file
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 TOML = ROOT / "examples" / "cylinder_winkler.toml"

@@ -1,8 +1,8 @@
-"""The exact steady JFO / Reynolds reference of line contact (femehl.line_jfo_steady).
+"""The exact steady JFO / Reynolds reference of line contact (femehl.reference.line_jfo_steady).
 
 Each test can fail: the conditions (3)-(7) of the module docstring are checked on the
 returned solution by finite differences, against closed forms and against the
-independent full-Sommerfeld code :mod:`femehl.line_steady`.
+independent full-Sommerfeld code :mod:`femehl.reference.line_steady`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from femehl.errors import SceneError
-from femehl.line_jfo_steady import pocket_slider, steady_full_film, steady_jfo, steady_reynolds
-from femehl.line_steady import steady_line
+from femehl.reference.line_jfo_steady import pocket_slider, steady_full_film, steady_jfo, steady_reynolds
+from femehl.reference.line_steady import steady_line
 
 K, BETA, HC = 1.0, 10.0, -0.5  # the Winkler cylinder of tests/test_line.py
 POCKET, POCKET_KINKS = pocket_slider()  # depth 0.3, width 1, center -1; ramp from x = 1

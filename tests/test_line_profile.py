@@ -7,9 +7,9 @@ import pytest
 
 from femehl.api import make_stepper, solve_line
 from femehl.errors import SceneError
-from femehl.line import LineScene
 from femehl.output.checkpoint import describe
-from femehl.scene import Constant, Motion, RampHold, TanhStart
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Constant, Motion, RampHold, TanhStart
 
 
 def motion():

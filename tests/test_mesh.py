@@ -1,4 +1,4 @@
-"""Tests of femehl.fe.mesh: the mesh ladder, graded_disk, load_mesh and its checks."""
+"""Tests of femehl.discretize.mesh: the mesh ladder, graded_disk, load_mesh and its checks."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import skfem
 
+from femehl.discretize.mesh import LADDER, DiskMesh, areas, centroids, graded_disk, ladder_path, load_mesh
 from femehl.errors import MeshError
-from femehl.fe import mesh as fm
-from femehl.fe.mesh import LADDER, DiskMesh, areas, centroids, graded_disk, ladder_path, load_mesh
+from femehl.discretize import mesh as fm
 
 NAMES = ["coarse", "medium", "fine", "xfine"]
 

@@ -13,7 +13,7 @@ import pytest
 import femehl
 from femehl.cli import main
 from femehl.output import COLUMNS
-from femehl.run import run_to_folder
+from femehl.output.run import run_to_folder
 
 
 def _sources(points, n):
@@ -133,7 +133,7 @@ def test_cli_bad_input_exit_code(tmp_path, capsys):
 
 def test_user_mesh_file(tmp_path):
     """Any mesh meshio reads is accepted (here a .vtu of the coarse ladder mesh)."""
-    from femehl.fe.mesh import load_mesh
+    from femehl.discretize.mesh import load_mesh
 
     dm = load_mesh("coarse")
     path = tmp_path / "mine.vtu"

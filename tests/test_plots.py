@@ -237,7 +237,7 @@ def test_cli_plot_bad_input(run, tmp_path, capsys, argv, words):
 
 
 def test_maps_of_a_run_without_series(tmp_path):
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     sc = femehl.presets.paper_sphere()
 
@@ -248,8 +248,8 @@ def test_maps_of_a_run_without_series(tmp_path):
 
 def test_line_contact_history_and_no_maps(tmp_path):
     """A line-contact run draws its history; maps of a 1-D run are refused, naming why."""
-    from femehl.run import run_to_folder
-    from femehl.scenefile import load_scene_file
+    from femehl.output.run import run_to_folder
+    from femehl.problem.scenefile import load_scene_file
 
     scene, _ = load_scene_file(pathlib.Path(__file__).parents[1] / "examples" / "cylinder_winkler.toml")
     run_to_folder(scene, tmp_path, t_end=0.2, dt=0.05, n_elements=200, store_every=2, log=lambda *a: None)
@@ -340,8 +340,8 @@ def test_centreline_of_a_full_sommerfeld_run_shades_nothing(run):
 def test_line_contact_shades_the_cavitated_interval():
     """line.png of a line-contact run with the Reynolds condition: the held nodes of the
     last state as one interval from the cavitation point to the outlet."""
-    from femehl.line import LineScene
-    from femehl.scene import Constant, Motion
+    from femehl.problem.line import LineScene
+    from femehl.problem.scene import Constant, Motion
 
     sc = LineScene(
         k=1e9,

@@ -23,8 +23,8 @@ import pytest
 from skfem import BilinearForm, asm
 
 import femehl
-from femehl.core.terms import Contribution, Poiseuille
-from femehl.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, Winkler
+from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, Winkler
+from femehl.solver.terms import Contribution, Poiseuille
 
 FE = dict(method="fe", mesh="coarse", linear_solver="lu")  # exact comparisons: direct solves
 FD = dict(method="fd", dr=0.1, dtheta=math.pi / 12)
@@ -194,7 +194,7 @@ def test_new_term_sliding_along_y_is_sliding_along_x_rotated():
 
 # ---- the registries ---------------------------------------------------------------------------
 @pytest.mark.parametrize(
-    "name", sorted(femehl.core.linsolve.LINEAR_SOLVERS) if hasattr(femehl, "core") else ["lu", "gmres"]
+    "name", sorted(femehl.solver.linsolve.LINEAR_SOLVERS) if hasattr(femehl, "core") else ["lu", "gmres"]
 )
 def test_every_linear_solver_solves_the_paper_step(name):
     """Every registered linear solver gives the direct solve's films (rtol 1e-10 per step)."""
@@ -212,8 +212,8 @@ def test_terms_must_have_distinct_names():
 
 def test_registered_substrate_is_a_scene_file_kind(tmp_path, monkeypatch):
     """A substrate registered from outside femehl is a ``[substrate] kind`` of TOML files."""
-    from femehl.scenefile import load_scene_file
-    from femehl.substrates import SUBSTRATES
+    from femehl.elastic import SUBSTRATES
+    from femehl.problem.scenefile import load_scene_file
 
     monkeypatch.setitem(SUBSTRATES, SeriesSprings.kind, SeriesSprings)
     path = tmp_path / "springs.toml"

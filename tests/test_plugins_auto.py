@@ -35,7 +35,7 @@ class SeriesSprings:
         return (disc.pressure_rows(points) * (1.0 / self.k1 + 1.0 / self.k2)).tocsr()
 
     def dry_contact(self, shape):
-        from femehl.substrates.contact import overlap_contact
+        from femehl.elastic.contact import overlap_contact
 
         return overlap_contact(shape, 1.0 / (1.0 / self.k1 + 1.0 / self.k2), "the series springs")
 

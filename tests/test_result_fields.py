@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl.scene import Motion, RampHold, Scene, Winkler
+from femehl.problem.scene import Motion, RampHold, Scene, Winkler
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,8 @@ import pytest
 
 import femehl
 from femehl.errors import OutputError
+from femehl.output.run import run_to_folder
 from femehl.output.table import ERROR_COLUMNS, read_summary
-from femehl.run import run_to_folder
 
 SCENE = femehl.presets.paper_sphere()
 RUN = dict(t_end=0.3, tol=5e-2, store_every=5)

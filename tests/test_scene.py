@@ -1,4 +1,4 @@
-"""Tests of femehl.scene, femehl.presets and femehl.stepping.march.
+"""Tests of femehl.problem.scene, femehl.presets and femehl.solver.stepping.march.
 
 Invalid values must raise :class:`femehl.errors.SceneError` (a ValueError)
 whose message names the fix; the SI conversion is checked against the
@@ -19,8 +19,8 @@ from hypothesis import strategies as st
 
 from femehl import api
 from femehl.errors import FilmRuptureError, SceneError, SolverError
-from femehl.presets import paper_sphere
-from femehl.scene import (
+from femehl.problem.presets import paper_sphere
+from femehl.problem.scene import (
     Constant,
     Dimensional,
     Domain,
@@ -35,7 +35,7 @@ from femehl.scene import (
     TanhStart,
     Winkler,
 )
-from femehl.stepping import State, check_run, march
+from femehl.solver.stepping import State, check_run, march
 
 
 def test_scene_error_is_value_error():

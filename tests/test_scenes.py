@@ -25,9 +25,9 @@ import femehl
 from femehl.api import make_stepper
 from femehl.cli import main as cli_main
 from femehl.errors import SceneError, SceneFileError
-from femehl.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape, Sphere, si_indenter
-from femehl.run import run_to_folder
-from femehl.scene import (
+from femehl.output.run import run_to_folder
+from femehl.problem.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape, Sphere, si_indenter
+from femehl.problem.scene import (
     Constant,
     Dimensional,
     Domain,
@@ -41,8 +41,8 @@ from femehl.scene import (
     Table,
     Winkler,
 )
-from femehl.scenefile import SUBSTRATES, load_scene_file
-from femehl.stepping import march
+from femehl.problem.scenefile import SUBSTRATES, load_scene_file
+from femehl.solver.stepping import march
 
 HERTZ_LOAD = 4.0 / (3.0 * math.pi)  # normalized Hertz load at hc = -1 (docs/design.md, section 2)
 

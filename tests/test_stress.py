@@ -30,7 +30,6 @@ import pytest
 
 import femehl
 from femehl import presets
-from femehl.baseline import RelaxationStepper, mass_balance_residual
 from femehl.errors import (
     CheckpointError,
     FilmRuptureError,
@@ -40,9 +39,10 @@ from femehl.errors import (
     SolverError,
 )
 from femehl.output.checkpoint import load_checkpoint
-from femehl.run import run_to_folder
-from femehl.scene import Domain, Fluid, Motion, RampHold, Rigid, Scene, Sphere
-from femehl.stepping import march
+from femehl.output.run import run_to_folder
+from femehl.problem.scene import Domain, Fluid, Motion, RampHold, Rigid, Scene, Sphere
+from femehl.reference.baseline import RelaxationStepper, mass_balance_residual
+from femehl.solver.stepping import march
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

@@ -15,8 +15,8 @@ pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 import femehl  # noqa: E402
-from femehl import sweeps as sw  # noqa: E402
 from femehl.cli import main  # noqa: E402
+from femehl.studies import sweeps as sw  # noqa: E402
 
 RUN = {"t_end": 0.2, "dt": 0.05, "mesh": "coarse", "store_every": 2}
 
@@ -172,7 +172,7 @@ def test_sweep_file_and_cli_errors(tmp_path, capsys):
 
 
 def test_fit_power_recovers_an_exponent():
-    from femehl.sweep_plot import fit_power
+    from femehl.studies.sweep_plot import fit_power
 
     x = np.geomspace(20, 20000, 7)
     n, c = fit_power(x, 3.0 * x**-0.6)
@@ -186,7 +186,7 @@ def test_master_curves_of_the_small_sweep(swept, capsys):
     import matplotlib
 
     matplotlib.use("Agg")
-    from femehl.sweep_plot import plot_master_curves
+    from femehl.studies.sweep_plot import plot_master_curves
 
     table, out, cases = swept
     png, lines = plot_master_curves(out, x="fluid.beta")
@@ -243,7 +243,7 @@ def test_the_example_sweep_and_its_committed_table():
     assert len(last) == 24 and set(last["status"]) == {"done"}
     # at beta = 20000 the film is thin (about 1e-3): the load is within 1 % of the dry Hertz
     # load of the same indentation (4/(3 pi) for the sphere)
-    from femehl.theory import hertz_load
+    from femehl.reference.theory import hertz_load
 
     big = last[last["fluid.beta"] == last["fluid.beta"].max()]
     for _, r in big.iterrows():

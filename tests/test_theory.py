@@ -1,4 +1,4 @@
-"""femehl.theory against independent computations.
+"""femehl.reference.theory against independent computations.
 
 The Hamrock-Dowson films are evaluated here in SI units straight from the published form
 (``H = A U^a W^b (1 - C exp(-D k))`` with ``U = eta u/(E' Rx)``, ``W = F/(E' Rx^2)``,
@@ -14,8 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from femehl import theory
 from femehl.errors import SceneError
+from femehl.reference import theory
 
 # ----------------------------------------------------------------- SI <-> femehl by hand
 

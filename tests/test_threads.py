@@ -7,7 +7,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 
 import femehl
 from femehl.errors import SceneError
-from femehl.threads import ENV, blas_threads, limited, one_blas_thread
+from femehl.solver.threads import ENV, blas_threads, limited, one_blas_thread
 
 
 def _blas():

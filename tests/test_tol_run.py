@@ -7,7 +7,7 @@ import csv
 import numpy as np
 
 from femehl.cli import main
-from femehl.scenefile import load_scene_file
+from femehl.problem.scenefile import load_scene_file
 
 
 def _times(folder):

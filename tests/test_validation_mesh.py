@@ -16,9 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import femehl.fe.mesh as M
-from femehl.errors import MeshError
-from femehl.fe.mesh import (
+import femehl.discretize.mesh as M
+from femehl.discretize.mesh import (
     LADDER,
     MAX_GMSH_ELEMENTS,
     check_mesh_memory,
@@ -29,7 +28,8 @@ from femehl.fe.mesh import (
     machine_memory,
     operator_bytes,
 )
-from femehl.scenefile import load_scene_file
+from femehl.errors import MeshError
+from femehl.problem.scenefile import load_scene_file
 
 
 # ---- 3. paths: directory, missing, unreadable, not a mesh ---------------------------------
@@ -141,7 +141,7 @@ def test_a_refresh_frees_the_old_lu_before_forming_the_new_matrix(monkeypatch):
     import weakref
 
     import femehl
-    from femehl.core import linsolve
+    from femehl.solver import linsolve
 
     lus, alive = [], []
     factorize = linsolve.StepOperator.factorize

@@ -18,12 +18,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import femehl.scene as scene_mod
+import femehl.problem.scene as scene_mod
 from femehl import validation
 from femehl.errors import SceneError, SceneFileError
-from femehl.indenters import Ellipsoid, FlatPunch, HeightMap, Shape, Sphere
-from femehl.scene import GAP_RISE, Constant, Domain, Motion, RampHold, Scene, Table
-from femehl.scenefile import load_scene_file, run_options
+from femehl.problem.indenters import Ellipsoid, FlatPunch, HeightMap, Shape, Sphere
+from femehl.problem.scene import GAP_RISE, Constant, Domain, Motion, RampHold, Scene, Table
+from femehl.problem.scenefile import load_scene_file, run_options
 
 GAP = Motion(gap=0.1)  # a positive clearance: no contact check, only the shape checks
 L = 2.0
@@ -37,12 +37,14 @@ def test_validators_are_shared_and_reexported():
 
 
 def test_indenters_imports_without_scene():
-    """femehl.indenters no longer imports femehl.scene (the former cycle), only femehl.validation."""
-    src = importlib.util.find_spec("femehl.indenters").origin
+    """femehl.problem.indenters does not import femehl.problem.scene (a former cycle), only
+    femehl.validation."""
+    src = importlib.util.find_spec("femehl.problem.indenters").origin
     with open(src, encoding="utf-8") as f:
         text = f.read()
-    assert "from .scene" not in text and "from .validation import" in text
-    code = "import femehl.indenters as i, femehl.validation as v; assert i.check_positive is v.check_positive"
+    assert "femehl.problem.scene" not in text and "from femehl.validation import" in text
+    code = "import femehl.problem.indenters as i, femehl.validation as v; "
+    code += "assert i.check_positive is v.check_positive"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 

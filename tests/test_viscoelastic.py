@@ -17,11 +17,11 @@ from scipy.special import erfc
 
 import femehl
 from femehl.errors import SceneError, SceneFileError
-from femehl.presets import paper_sphere
-from femehl.scene import Domain, Fluid, Motion, Scene, Sphere, Table
-from femehl.stepping import State, get_scheme
-from femehl.theory import hertz_load
-from femehl.tribology import sliding_energetics
+from femehl.problem.presets import paper_sphere
+from femehl.problem.scene import Domain, Fluid, Motion, Scene, Sphere, Table
+from femehl.reference.theory import hertz_load
+from femehl.solver.energetics import sliding_energetics
+from femehl.solver.stepping import State, get_scheme
 
 SLS = femehl.Viscoelastic(G0=1.0, G_inf=0.5, tau=0.5)  # J0 = 1, J_inf = 2, tau_c = 1
 
@@ -148,7 +148,7 @@ def test_steady_sliding_energy_balance():
 
 
 def test_resume_continues_the_memory(tmp_path):
-    from femehl.run import run_to_folder
+    from femehl.output.run import run_to_folder
 
     sc = dataclasses.replace(paper_sphere(), substrate=SLS)
     opts = dict(mesh="coarse", dt=0.04, scheme="bdf2", linear_solver="lu", log=lambda *a: None)
@@ -177,7 +177,7 @@ def test_bad_viscoelastic(kw, words):
 def test_toml(tmp_path):
     import pathlib
 
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     old = '[substrate]\nkind = "halfspace"     # "halfspace" (nu), "winkler" (k), "rigid"\nnu = 0.5'
@@ -203,7 +203,7 @@ def test_viscoelastic_line_contact_reaches_the_steady_solution():
     +5.8e-6 at dt = 0.05 and 0.1 (the old backward-difference memory: +0.12 % and +0.47 %,
     second order in 2 V dt): the memory's integration along the characteristic is exact
     for a steady source, what is left is the spatial error."""
-    from femehl.line import LineScene
+    from femehl.problem.line import LineScene
     from femehl.reference.viscoelastic_line import steady_viscoelastic_line
 
     ref = steady_viscoelastic_line(1.0, 10.0, -0.5, 2.0, 1.0, SLS)
@@ -224,7 +224,7 @@ def test_viscoelastic_line_contact_reaches_the_steady_solution():
 def test_line_toml_viscoelastic(tmp_path):
     import pathlib
 
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "cylinder_winkler.toml").read_text()
     start = src.index("[substrate]")

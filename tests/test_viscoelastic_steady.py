@@ -1,6 +1,6 @@
 """Steady sliding on a standard-linear-solid Winkler foundation: femehl's runs (automatic
 and expert mode) against the collocation reference femehl.reference.viscoelastic_line,
-and that reference against its elastic limits (femehl.line_steady, shooting)."""
+and that reference against its elastic limits (femehl.reference.line_steady, shooting)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import femehl
-from femehl.line import LineScene
-from femehl.line_steady import steady_line
+from femehl.problem.line import LineScene
+from femehl.reference.line_steady import steady_line
 from femehl.reference.viscoelastic_line import steady_viscoelastic_line
 
 K, BETA, HC, L, V = 1.0, 10.0, -0.5, 2.0, 1.0  # the default LineScene's steady sliding
@@ -76,7 +76,7 @@ def test_fixed_steps_give_the_same_steady_state():
 def test_step_limit():
     """The substrate states its limit; substrates without memory have none."""
     from femehl.api import make_stepper
-    from femehl.substrates.base import step_limit
+    from femehl.elastic.base import step_limit
 
     scene = LineScene(k=K, beta=BETA, viscoelastic=sls(1.0))
     disc = make_stepper(scene, "line").disc

@@ -19,10 +19,10 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
 
 import femehl
+from femehl.elastic import Rigid
 from femehl.errors import SceneError
-from femehl.line import LineScene
-from femehl.scene import Constant, Domain, Fluid, Motion, Scene
-from femehl.substrates import Rigid
+from femehl.problem.line import LineScene
+from femehl.problem.scene import Constant, Domain, Fluid, Motion, Scene
 
 HC, BETA, L = 0.2, 10.0, 2.0
 
@@ -125,8 +125,8 @@ def test_alpha_zero_is_the_isoviscous_run():
 
 def test_isoviscous_scenes_assemble_the_newtonian_mobility():
     from femehl.api import make_stepper
-    from femehl.core.terms import Newtonian
-    from femehl.viscosity import PiezoviscousMobility
+    from femehl.problem.viscosity import PiezoviscousMobility
+    from femehl.solver.terms import Newtonian
 
     sc = femehl.presets.paper_sphere()
     st = make_stepper(sc, mesh="coarse")
@@ -179,7 +179,7 @@ def test_fd_refuses_a_pressure_dependent_viscosity():
 
 
 def test_toml(tmp_path):
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "paper_sphere.toml").read_text()
     f = tmp_path / "s.toml"
@@ -199,7 +199,7 @@ def test_toml(tmp_path):
 
 def test_si_scene_file(tmp_path):
     """[si] alpha (1/Pa) is Barus.from_si; roelands_Z is Roelands.from_si with eta as eta0."""
-    from femehl.scenefile import load_scene_file
+    from femehl.problem.scenefile import load_scene_file
 
     src = (pathlib.Path(__file__).parents[1] / "examples" / "sphere_si.toml").read_text()
     f = tmp_path / "s.toml"

@@ -5,7 +5,7 @@
   solvers, the adaptive step controls and the automatic driver, with the descriptions
   of their numpydoc ``Parameters`` sections;
 * ``.. femehl-toml-keys::`` -- the tables and keys of a TOML scene file, read from the
-  registries of :mod:`femehl.scenefile`;
+  registries of :mod:`femehl.problem.scenefile`;
 * the example gallery: a copy of ``examples/`` under ``docs/_build`` (examples write
   their output into the folder they run in), and an image scraper that shows the PNGs an
   example writes (femehl's run folders close their figures).
@@ -179,9 +179,9 @@ class SolveOptions(Directive):
 
     def run(self):
         from femehl import api, auto
-        from femehl.core import adaptive, linsolve
-        from femehl.core.stepper import LaggedStepper
-        from femehl.discretizations import METHODS, method_class
+        from femehl.discretize import METHODS, method_class
+        from femehl.solver import adaptive, linsolve
+        from femehl.solver.stepper import LaggedStepper
 
         method_class("fe")  # imports every registered discretization
         groups = []
@@ -214,7 +214,9 @@ class SolveOptions(Directive):
                 cls,
                 skip={"scene"},
             )
-        group("The stepper (every method)", "femehl.core.stepper.LaggedStepper", LaggedStepper, skip={"disc"})
+        group(
+            "The stepper (every method)", "femehl.solver.stepper.LaggedStepper", LaggedStepper, skip={"disc"}
+        )
         for key in sorted(linsolve.LINEAR_SOLVERS):
             sol = linsolve.LINEAR_SOLVERS[key]
             if inspect.signature(sol).parameters:
@@ -225,13 +227,13 @@ class SolveOptions(Directive):
                 )
         group(
             "Adaptive time steps (expert mode with ``tol``)",
-            "femehl.core.adaptive.march_adaptive",
+            "femehl.solver.adaptive.march_adaptive",
             adaptive.march_adaptive,
             names=set(adaptive.CONTROLS),
         )
         group(
             "Automatic mode (no ``dt``, no discretization option)",
-            "femehl.auto.solve_to_tolerance",
+            "femehl.accuracy.auto.solve_to_tolerance",
             auto.solve_to_tolerance,
             names={"max_elements", "max_wall", "level"},
         )
@@ -286,7 +288,7 @@ class TomlKeys(Directive):
     has_content = False
 
     def run(self):
-        from femehl import scenefile
+        from femehl.problem import scenefile
 
         lines = [".. rubric:: ``[indenter]`` kinds", ""]
         indenters = {k: v for k, v in scenefile.INDENTERS.items() if k != "shape"}
@@ -332,11 +334,11 @@ class TomlKeys(Directive):
         lines += [
             ".. rubric:: ``[si]`` keys (the paper's experiment in SI units)",
             "",
-            "The parameters of :class:`femehl.scene.Dimensional` and of its "
-            ":meth:`~femehl.scene.Dimensional.scene`, and ``load``:",
+            "The parameters of :class:`femehl.problem.scene.Dimensional` and of its "
+            ":meth:`~femehl.problem.scene.Dimensional.scene`, and ``load``:",
             "",
         ]
-        from femehl.scene import Dimensional
+        from femehl.problem.scene import Dimensional
 
         si = {**_param_docs(Dimensional), **_param_docs(Dimensional.scene)}
         rows = [(f"``{k}``", typ, desc) for k, (typ, desc) in si.items()]

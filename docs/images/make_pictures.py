@@ -20,7 +20,7 @@ from pathlib import Path
 
 import femehl
 from femehl.output import plots
-from femehl.run import run_to_folder
+from femehl.output.run import run_to_folder
 
 HERE = Path(__file__).resolve().parent
 

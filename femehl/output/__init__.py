@@ -2,7 +2,7 @@
 
 Nothing here steps a solver.  :class:`RunWriter` is the callback a run
 hands each State to, so files appear while the run goes; :func:`write_all`
-writes the same from a finished :class:`~femehl.result.Result`.
+writes the same from a finished :class:`~femehl.output.result.Result`.
 :mod:`femehl.output.folder` decides whether a folder may be written (it
 refuses one that holds another run unless asked to overwrite or resume), and
 :mod:`femehl.output._validation` checks run and command-line options first.
@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import pathlib
 
-from .folder import check_folder, prepare_folder
-from .plots import (
+from femehl.output.folder import check_folder, prepare_folder
+from femehl.output.plots import (
     animation_file,
     centreline_png,
     draw_figures,
@@ -23,9 +23,9 @@ from .plots import (
     profile_times,
     result_table,
 )
-from .series import SeriesWriter
-from .snapshot import Snapshot, read_snapshot, snapshot
-from .table import COLUMNS, SummaryWriter, add_error_columns, columns_for, write_summary
+from femehl.output.series import SeriesWriter
+from femehl.output.snapshot import Snapshot, read_snapshot, snapshot
+from femehl.output.table import COLUMNS, SummaryWriter, add_error_columns, columns_for, write_summary
 
 __all__ = [
     "COLUMNS",

@@ -16,7 +16,7 @@ import errno
 import os
 import pathlib
 
-from ..errors import OutputError
+from femehl.errors import OutputError
 
 __all__ = ["out_path", "write_atomic", "writing"]
 

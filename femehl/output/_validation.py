@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numbers
 
-from ..errors import SceneError
+from femehl.errors import SceneError
 
 __all__ = [
     "METHOD_FLAGS",
@@ -55,7 +55,7 @@ def check_tol(tol):
     """``tol`` as a float in (0, 0.5), or None (fixed time steps)."""
     if tol is None:
         return None
-    from ..validation import check_positive
+    from femehl.validation import check_positive
 
     tol = check_positive("tol", tol, "Give the relative error per unit time, e.g. tol = 1e-2.")
     if tol >= 0.5:
@@ -68,7 +68,7 @@ def check_run_options(t_end, dt, store_every, checkpoint_every):
 
     ``checkpoint_every`` None means ``store_every``; 0 means only at the end.
     """
-    from ..stepping import check_run
+    from femehl.solver.stepping import check_run
 
     t_end, dt, nsteps = check_run(t_end, dt)
     store_every = check_count(
@@ -92,7 +92,7 @@ def check_divisions(value) -> int:
 
 def check_step(name: str, value) -> float:
     """A finite grid step > 0 (``--dr``)."""
-    from ..scene import check_positive
+    from femehl.problem.scene import check_positive
 
     return check_positive(name, value, "Give a positive grid step (FD default 0.0125).")
 

@@ -1,6 +1,6 @@
 """Checkpoints: the last State of a run, so that it can be resumed.
 
-``folder/checkpoint.npz`` holds one :class:`~femehl.stepping.State` (its
+``folder/checkpoint.npz`` holds one :class:`~femehl.solver.stepping.State` (its
 arrays and scalars, including ``d_prev``/``dt_prev`` of two-step schemes) and
 ``folder/checkpoint.json`` the run's parameters: the scene (described field
 by field), the method and the discretization actually built (mesh name,
@@ -8,7 +8,7 @@ element and node counts, a hash of the node coordinates; FD: dr, dtheta and
 grid size).  Both are written atomically (temporary file + rename), so a
 run killed at any moment leaves the previous checkpoint intact.
 
-:func:`femehl.run.run_to_folder` writes a checkpoint every
+:func:`femehl.output.run.run_to_folder` writes a checkpoint every
 ``checkpoint_every`` steps and at the end of the run (also when it stops on a
 :class:`~femehl.errors.SolverError`: then it holds the last good state), and
 ``run_to_folder(..., resume=True)`` continues from it after
@@ -38,9 +38,9 @@ import zlib
 
 import numpy as np
 
-from ..cavitation import CAVITATION_COLUMNS
-from ..errors import CheckpointError, SceneError
-from ..stepping import State
+from femehl.errors import CheckpointError, SceneError
+from femehl.solver.cavitation import CAVITATION_COLUMNS
+from femehl.solver.stepping import State
 
 logger = logging.getLogger("femehl")
 
@@ -384,7 +384,7 @@ def _align_summary(path: pathlib.Path, columns: tuple) -> None:
     if not rows or tuple(rows[0]) == tuple(columns):
         return
     where = {c: i for i, c in enumerate(rows[0])}
-    from .table import EARLIER_ESTIMATE, ERROR_COLUMNS
+    from femehl.output.table import EARLIER_ESTIMATE, ERROR_COLUMNS
 
     kept = [c for c in ERROR_COLUMNS if c in where]
     earlier = path.with_name(EARLIER_ESTIMATE)
@@ -408,7 +408,7 @@ def _align_summary(path: pathlib.Path, columns: tuple) -> None:
 
 def _continue_series(writer, t_ckpt: float) -> None:
     """Point a SeriesWriter at the files present: index up to ``t_ckpt``, numbering after all."""
-    from .series import scan_series
+    from femehl.output.series import scan_series
 
     tol = 1e-9 * max(1.0, abs(t_ckpt))
     found = scan_series(writer.folder, writer.stem)
@@ -426,14 +426,14 @@ def _continue_series(writer, t_ckpt: float) -> None:
 
 def resume_writer(folder, disc, every: int, t_ckpt: float):
     """A :class:`~femehl.output.RunWriter` that appends to the existing outputs of ``folder``."""
-    from . import RunWriter
-    from .series import SeriesWriter
-    from .table import SummaryWriter
+    from femehl.output import RunWriter
+    from femehl.output.series import SeriesWriter
+    from femehl.output.table import SummaryWriter
 
     folder = pathlib.Path(folder)
     summary = folder / "summary.csv"
     _cut_summary(summary, t_ckpt)
-    from .table import columns_for
+    from femehl.output.table import columns_for
 
     columns = columns_for(getattr(disc, "scene", None))
     _align_summary(summary, columns)

@@ -12,7 +12,7 @@ import os
 import pathlib
 import re
 
-from ..errors import CheckpointError, OutputError
+from femehl.errors import CheckpointError, OutputError
 
 __all__ = ["RUN_FILES", "check_folder", "clear_run_files", "prepare_folder", "run_files"]
 

@@ -73,7 +73,7 @@ def _plt():
 def _save(plt, fig, path, dpi):
     """Save ``fig`` to ``path`` (atomically: a failed write leaves the file there untouched);
     a fault (unwritable folder, full disk) is an :class:`~femehl.errors.OutputError`."""
-    from ._files import write_atomic
+    from femehl.output._files import write_atomic
 
     path = pathlib.Path(path)
     try:
@@ -93,7 +93,7 @@ def figure_suffixes() -> frozenset:
 
 def _out(out, folder, name):
     """The file ``--out`` names for the picture ``name`` (see :func:`femehl.output._files.out_path`)."""
-    from ._files import out_path
+    from femehl.output._files import out_path
 
     suffixes = {".gif"} if name.endswith(".gif") else figure_suffixes()
     return out_path(out, folder, name, suffixes)
@@ -175,7 +175,7 @@ def centreline_png(results, path, times=None, labels=None, L=None):
             ax2.plot(x, res.film_at(pts, t), **kw)
     first = results[0]
     if getattr(first.scene, "cavitation", None) is not None and first.states:
-        from .snapshot import snapshot
+        from femehl.output.snapshot import snapshot
 
         snap = snapshot(first.disc, first.state_at(times[-1]))
         if snap.cavitated is not None:
@@ -479,7 +479,7 @@ def centreline_name(t: float) -> str:
 def plot_centreline(folder, t=None, out=None):
     """``centreline_tT.png`` of a run folder: p and d along y = 0 at the stored time
     nearest ``t`` (default: the last), the cavitated interval(s) shaded."""
-    from .snapshot import read_snapshot
+    from femehl.output.snapshot import read_snapshot
 
     _out(out, folder, "centreline.png")  # a bad --out is refused before anything is read
     snap = read_snapshot(folder, t, what="centreline")
@@ -499,7 +499,7 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
     import matplotlib.tri as mtri
 
     plt = _plt()
-    from ..errors import OutputError
+    from femehl.errors import OutputError
 
     get, count = snaps if isinstance(snaps, tuple) else ((lambda k: snaps[k]), len(snaps))
     if count < 1:
@@ -514,7 +514,7 @@ def animation_file(snaps, path, fps: int = 8, title: str = ""):
     pnorm = mcolors.TwoSlopeNorm(vcenter=0.0, vmin=-0.5 * top, vmax=1.2 * top)
     writer = manim.PillowWriter(fps=int(fps))
     path = pathlib.Path(path)
-    from ._files import write_atomic
+    from femehl.output._files import write_atomic
 
     def frames(tmp):
         _animate(writer, fig, tmp, get, count, last, (ax_d, ax_p, ax_c), tri, dnorm, pnorm, W, top, title)
@@ -564,7 +564,7 @@ def line_png(result, path):
 def line_figure(result):
     """p(x) and d(x) at a few stored times of a line-contact run, the cavitated interval(s)
     of the last one shaded (a run with a cavitation condition)."""
-    from .series import cavitated_nodes
+    from femehl.output.series import cavitated_nodes
 
     plt = _plt()
     states = list(result.states[:: max(1, len(result.states) // 6)])
@@ -583,7 +583,7 @@ def line_figure(result):
     cav = cavitated_nodes(result.disc, result.final)
     if cav is not None:
         spans = cavitated_intervals(result.disc.x, cav)
-        from ..cavitation import clips_pressure
+        from femehl.solver.cavitation import clips_pressure
 
         label = _cavitation_label(clips_pressure(result.scene))
         for k, (a, b) in enumerate(spans):
@@ -599,7 +599,7 @@ def line_figure(result):
 def _history(result, path):
     """A run folder's history from its summary.csv (the whole run, also when resumed), else
     from the Result."""
-    from .table import read_summary
+    from femehl.output.table import read_summary
 
     csv = pathlib.Path(path).parent / "summary.csv"
     table = read_summary(csv) if csv.is_file() else result_table(result)
@@ -607,7 +607,7 @@ def _history(result, path):
 
 
 def _maps(result, path):
-    from .snapshot import snapshot
+    from femehl.output.snapshot import snapshot
 
     return maps_png(snapshot(result.disc, result.final), path, title=_title(result))
 
@@ -643,9 +643,9 @@ def _title_of(folder) -> str:
 
 def plot_history(folder, out=None):
     """``history.png`` of a run folder from its ``summary.csv`` (``out``: another file)."""
-    from ..errors import OutputError
-    from .snapshot import check_run_folder
-    from .table import read_summary
+    from femehl.errors import OutputError
+    from femehl.output.snapshot import check_run_folder
+    from femehl.output.table import read_summary
 
     folder = check_run_folder(folder)
     path = _out(out, folder, "history.png")
@@ -668,7 +668,7 @@ def maps_name(t: float | None) -> str:
 
 def plot_maps(folder, t=None, out=None):
     """The contact maps of a run folder at the stored time nearest ``t`` (default: the last)."""
-    from .snapshot import read_snapshot
+    from femehl.output.snapshot import read_snapshot
 
     _out(out, folder, "maps.png")  # a bad --out is refused before anything is read
     snap = read_snapshot(folder, t, what="maps")
@@ -678,12 +678,12 @@ def plot_maps(folder, t=None, out=None):
 
 def plot_animation(folder, out=None, fps: int = 8):
     """``animation.gif`` of a run folder: one frame per stored field file."""
-    from ..errors import OutputError
-    from .snapshot import damaged_files, read_snapshot, stored_times
+    from femehl.errors import OutputError
+    from femehl.output.snapshot import damaged_files, read_snapshot, stored_times
 
     if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 60:
         raise OutputError(f"fps must be an integer from 1 to 60, got {fps!r}.")
-    from .table import read_summary
+    from femehl.output.table import read_summary
 
     path = _out(out, folder, "animation.gif")
     read_snapshot(folder, report=False)  # a run folder with a readable series (else OutputError)

@@ -5,7 +5,8 @@ small .pvd index (atomically), so an interrupted run leaves a readable
 series.  Pressure is point data (with ``cavitated``, 1 where the pressure is held at 0
 or, half-Sommerfeld, was clipped, for a run with a cavitation condition; a half-Sommerfeld
 run's files carry the field data ``HalfSommerfeldClipped = 1`` and, as an XML comment, how
-to read them: :attr:`femehl.cavitation.HalfSommerfeld.note`); film thickness ``d``, deflection ``w`` and
+to read them: :attr:`femehl.solver.cavitation.HalfSommerfeld.note`);
+film thickness ``d``, deflection ``w`` and
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
 normalized; z = 0.  A half-disk run (computed on y >= 0) is written as the
@@ -31,7 +32,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from .mirror import mirror_half
+from femehl.output.mirror import mirror_half
 
 __all__ = ["SeriesWriter", "field_value", "grid_cells", "read_index", "scan_series", "vtu_time"]
 
@@ -68,7 +69,7 @@ class SeriesWriter:
         self._source = None
         if self.mirrored:
             self.points, self.cells, self._source = mirror_half(self.points, self.cells)
-        from ..cavitation import cavitation_model
+        from femehl.solver.cavitation import cavitation_model
 
         self.cavitation = cavitation_model(getattr(getattr(disc, "scene", None), "cavitation", None))
         self.entries: list[tuple[float, str]] = []

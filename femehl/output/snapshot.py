@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import OutputError
-from .mirror import mirror_half
-from .series import cavitated_nodes, field_value, scan_series
+from femehl.errors import OutputError
+from femehl.output.mirror import mirror_half
+from femehl.output.series import cavitated_nodes, field_value, scan_series
 
 logger = logging.getLogger("femehl")
 
@@ -142,7 +142,7 @@ def snapshot(disc, state) -> Snapshot:
         cells = full_cells
     L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
     fmin, at = state.film_min, tuple(state.film_min_at)
-    from ..cavitation import clips_pressure
+    from femehl.solver.cavitation import clips_pressure
 
     clipped = clips_pressure(getattr(disc, "scene", None))
     return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav, clipped)
@@ -194,7 +194,7 @@ def read_snapshot(
     """
     import meshio
 
-    from .table import read_summary
+    from femehl.output.table import read_summary
 
     folder = check_run_folder(folder)
     files = stored_times(folder)

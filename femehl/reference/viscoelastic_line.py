@@ -3,10 +3,10 @@
 Independent of femehl's time stepping: the steady equations are solved directly as a
 two-point boundary value problem by collocation (:func:`scipy.integrate.solve_bvp`).
 
-At steady sliding (V, hc constant) the line contact of :mod:`femehl.line` on the foundation
+At steady sliding (V, hc constant) the line contact of :mod:`femehl.problem.line` on the foundation
 ``Viscoelastic(G0, tau, G_inf, elastic=Winkler(k))`` has the film
 ``d = hc + x^2/2 + J0 p/k + q``; the Reynolds equation integrates once to a constant
-flux (as in :mod:`femehl.line_steady`) and the creep's memory equation
+flux (as in :mod:`femehl.reference.line_steady`) and the creep's memory equation
 ``tau_c Dq/Dt = dJ p/k - q`` with ``D/Dt = -2 V d/dx`` (the material moves at ``-2V``)
 is an ODE along x::
 
@@ -15,7 +15,7 @@ is an ODE along x::
 
 with ``d_*`` (the film where p' = 0) a free parameter: three conditions for two first
 order equations and one parameter.  The solution is continued in ``dJ`` from the elastic
-one of :mod:`femehl.line_steady` (compliance J0).  Energetics (:mod:`femehl.tribology`,
+one of :mod:`femehl.reference.line_steady` (compliance J0).  Energetics (:mod:`femehl.solver.energetics`,
 per unit length, ``W = -(J0 p/k + q)``)::
 
     f = int [V/(6 beta d) - (W + d/2) p'] dx,   D_film = int [V^2/(6 beta d) + (beta/2) d^3 p'^2] dx,
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, SolverError
+from femehl.errors import SceneError, SolverError
 
 __all__ = ["SteadyViscoelasticLine", "steady_viscoelastic_line"]
 
@@ -60,7 +60,7 @@ def steady_viscoelastic_line(
     """
     from scipy.integrate import solve_bvp
 
-    from ..line_steady import steady_line
+    from femehl.reference.line_steady import steady_line
 
     if not V > 0.0:
         raise SceneError(f"the steady sliding reference needs V > 0, got {V!r}.")

@@ -1,0 +1,854 @@
+"""Any scene to a requested accuracy, with an error estimate: :func:`solve_to_tolerance`.
+
+``femehl.solve(scene, t_end=..., tol=1e-2)`` (and ``femehl run``) end up here when the
+caller gives neither ``dt`` nor a discretization option (``mesh=``, ``n_elements=``...).
+
+What ``tol`` means
+------------------
+The load, the central film and the minimum film (the true minimum over film points,
+origin and nodes, :mod:`femehl.solver.stepper`) at every step of the returned run are
+within ``tol`` relative (the load relative to ``max(|load|, 0.1)``: a load growing from 0
+has no relative error at t = 0): the estimate below is at most ``ACCEPT * tol`` = 0.75
+tol, a margin for the estimate running up to a quarter below the true error.  The fields
+are not estimated separately: the film and pressure errors in the max norm over the film
+points are what the time controller bounds per step, and the mesh is the one whose
+headline errors pass.
+
+One number refines everything: the level
+----------------------------------------
+A method is automatic when it has a :class:`Ladder` in :data:`LADDERS`: a map from a
+``level`` (element sizes proportional to it) to its discretization options.  FE
+(``"fe"``) uses the scene-fitted gmsh mesh :func:`femehl.discretize.fitted.fitted_disk` (level 1:
+the ``medium`` ladder rung's sizes for the paper sphere), line contact (``"line"``)
+``n_elements = 400 / level``.  FD has none (it is the cross-check of FE, run by hand).
+Every run at ``level`` takes adaptive BDF2 steps (:mod:`femehl.solver.adaptive`) at the
+time tolerance ``tol_t = TAU1 * level**2`` (:func:`time_tolerance`), so that its space
+error (order 2 in h) and its time error (proportional to ``tol_t``) both scale like
+``level**2``: one ratio ``r`` between two levels divides the whole error by ``r**2``.
+
+The sequence
+------------
+Levels 4, 2 (pilots: cheap, their fields never written), then each next level aims at
+an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
+``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
+accepted when it is at least the third and its estimate is <= ``ACCEPT * tol`` = 0.75
+tol (:data:`ACCEPT`: the margin for the estimate's measured shortfall).  A level whose cells
+would exceed ``max_elements`` (:func:`cell_budget`: 100,000 on a substrate with the fast
+hierarchical operator or with sparse operators only, a cost budget a caller may raise;
+25,000 on one whose operator is dense only, a layer, where the dense influence matrix
+of about 3 GB is the limit) is not run.  Instead the finest level within the budget is
+run, if it is at least :data:`BUDGET_RATIO` = 1.2 times finer than the last run
+(:func:`budget_level`), and the sequence stops there: when it does not reach ``tol``
+(or no such level exists) the last run is returned with ``info["auto"]["reached"] =
+False`` and a logging warning.  A time budget ``max_wall`` (seconds, default none) works the same way on the
+predicted wall time of each next run (:func:`predicted_wall`: the last run's cost per
+step times the cells ratio to the power fitted on the last two runs, times ``r`` times
+its steps): a level predicted to overrun what is left is not started, the finest level
+predicted to fit is run instead if it is at least BUDGET_RATIO finer; then the next level
+is predicted again from the runs so far (a run cheaper than predicted leaves time for
+another), and the sequence stops, with ``info["auto"]["stopped"] = "time budget"``, when
+no level BUDGET_RATIO finer than the last run is predicted to fit.  A run held in memory
+(every run of :func:`femehl.solve`, the pilots of ``femehl run``) that is still going at
+the deadline is abandoned and the last finished run returned; a candidate streaming into
+a run folder always finishes (its files replace the previous candidate's).  When no run
+finished in time, :class:`~femehl.errors.TimeBudgetError`.  The companion of the
+returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
+fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
+itself; the pilots less than that.
+
+Estimators (relative, one array per quantity on the returned run's ``t``)
+--------------------------------------------------------------------------
+* **total** (Richardson, :func:`pair_error`): with ``q_f`` the returned run and ``q_c``
+  the previous one (``r`` times its level, interpolated to ``q_f``'s times),
+  ``|q_f - q_c| / (r**2 - 1)``, then its running maximum over the steps so far (the
+  difference changes sign in time, the error does not vanish where it does).
+* **time**: the accumulated local errors of the returned run's controller,
+  ``sum error_estimate * max(dt, 0.01)`` (:func:`time_error`), at most ``total``;
+  **space** = total - time.  An expert run with adaptive steps (``tol`` and a mesh) gets
+  the time part only.
+
+Why TAU1 = 1.25e-3: with larger time tolerances the time part dominates the pair, and
+the BDF2 global error follows ``tol_t`` less exactly than the space error follows h^2;
+at 5e-3 and 2.5e-3 the estimate fell below half the true error at 14-18 % of the steps
+on line contact at tol = 1e-3 and on the paper sphere at tol = 3e-2
+(tests/test_auto.py), at 1.25e-3 at under 10 %.
+
+Measured (tests/test_auto.py, benchmarks/auto_results.md): line contact and the paper
+sphere are within tol with the estimate >= half the true error at >= 90 % of the steps.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from femehl.errors import SceneError, SolverError, TimeBudgetError
+from femehl.output.result import Result
+from femehl.solver.adaptive import LOAD_FLOOR, UNIT_STEP, breakpoints_of
+
+__all__ = [
+    "solve_to_tolerance",
+    "Ladder",
+    "LADDERS",
+    "register_ladder",
+    "QUANTITIES",
+    "ACCEPT",
+    "MAX_ELEMENTS",
+    "LOCAL_MAX_ELEMENTS",
+    "FAST_MAX_ELEMENTS",
+    "cell_budget",
+    "budget_level",
+    "predicted_wall",
+    "time_tolerance",
+]
+
+logger = logging.getLogger("femehl")
+
+#: the headline quantities whose errors are estimated
+QUANTITIES = ("load", "film_center", "film_min")
+#: observed/expected order of the space error in h and of the BDF2 global time error in tol_t
+ORDER = 2
+#: levels whose discretization would have more cells than this are not run, on a
+#: substrate whose elastic operator is dense only (``operators = ("dense",)``: a layer)
+MAX_ELEMENTS = 25_000
+#: ... on a substrate with the fast hierarchical operator (the half space, compressible
+#: or not; a viscoelastic one relaxing it), used by the FE method from 8,000 elements
+#: on: its memory grows like the cells (20 kB each) and a step costs about 1 s at
+#: 89,000 cells (``benchmarks/fast_operator.md``), so this is a cost budget, not a
+#: memory limit
+FAST_MAX_ELEMENTS = 100_000
+#: ... on a substrate whose operators are all sparse (``substrate.local``: Winkler,
+#: rigid): a step there costs a sparse LU, not dense products, so the same cost buys
+#: more cells.  Measured on the Winkler scene of ``benchmarks/auto.py`` (adaptive BDF2,
+#: another run beside it): 29 ms per step at 11,458 cells, 183 ms at 45,182; a dense
+#: step at 27,640 cells costs about 900 ms (``benchmarks/fast_operator.md``).
+LOCAL_MAX_ELEMENTS = 100_000
+#: time tolerance of the run at level 1: ``tol_t = TAU1 * level**2``
+TAU1 = 1.25e-3
+#: bounds of the time tolerance
+TAU_RANGE = (1e-6, 5e-2)
+#: first (coarsest) level, and the least number of runs before one is accepted
+LEVEL0 = 4.0
+MIN_RUNS = 3
+#: the next level aims at an estimated error of SAFETY * tol ...
+SAFETY = 0.6
+#: a run is accepted (``reached``) when its worst estimate is <= ACCEPT * tol.  The
+#: estimate assumes order 2; on the fitted meshes the films converge somewhat slower
+#: between the levels that decide (observed orders 1.4-2), so it runs low.  Over the pairs
+#: of the eleven tol = 1e-2 scenes of ``benchmarks/auto_margin.py`` at levels <= 1 whose
+#: worst true error is at least twice its reference's uncertainty, worst true / worst
+#: estimate was at most 1.23 (22 pairs, above 1 in 11), 1.29 where the reference is as
+#: uncertain as the error; accepted at <= tol, the sphere sliding at beta = 2000 and the
+#: ellipsoid along the sliding ended 14 % and 5 % over tol.  1 / 0.75 = 1.33 covers both ratios.
+ACCEPT = 0.75
+#: ... with a ratio to the previous level in this range
+RATIO_RANGE = (math.sqrt(2.0), 2.0)
+#: the level the estimate asks for would exceed the cell budget: the finest level within
+#: it is still run if it is at least this ratio finer than the last run (its pair estimate
+#: divides the difference by ratio**2 - 1 >= 0.44), found to about 1 % in cells
+BUDGET_RATIO = 1.2
+BUDGET_BISECTIONS = 8
+
+
+def time_tolerance(level: float) -> float:
+    """The adaptive controller's tolerance on ``level``: ``TAU1 * level**2`` (clipped)."""
+    lo, hi = TAU_RANGE
+    return float(min(hi, max(lo, TAU1 * level**2)))
+
+
+# ---- how each method is refined ---------------------------------------------------------
+@dataclass(frozen=True)
+class Ladder:
+    """How a method is refined by one number, ``level`` (sizes proportional to it).
+
+    ``options(scene, t_end, level)`` gives the discretization options of
+    :func:`femehl.solve` (e.g. ``mesh=``); ``cells(scene, t_end, level)`` estimates the
+    number of cells (elements) without building anything, for the budget.
+    """
+
+    options: Callable[..., dict]
+    cells: Callable[..., float]
+    #: the option names ``options`` sets (refused from the caller)
+    keys: tuple[str, ...] = ()
+    #: ``companion(scene, options) -> (options, ratio) | None``: a coarser discretization
+    #: (sizes ``ratio`` times) of an expert's options, for the space estimate of an expert run
+    companion: Callable[..., tuple | None] | None = None
+    #: ``sizer(scene, t_end) -> cells(level)``: :attr:`cells` with what does not depend on
+    #: the level computed once (the budgets ask for many levels); default: :attr:`cells`
+    sizer: Callable[..., Callable[[float], float]] | None = None
+
+    def cells_of(self, scene, t_end: float) -> Callable[[float], float]:
+        """``cells(level)`` of ``scene`` over a run to ``t_end``."""
+        if self.sizer is not None:
+            return self.sizer(scene, t_end)
+        return lambda level: self.cells(scene, t_end, level)
+
+
+#: method name -> its :class:`Ladder`
+LADDERS: dict[str, Ladder] = {}
+
+
+def register_ladder(method: str, ladder: Ladder) -> Ladder:
+    """Make ``method`` automatic: :func:`solve_to_tolerance` refines it along ``ladder``."""
+    if not isinstance(ladder, Ladder):
+        raise SceneError(f"register_ladder: give a femehl.auto.Ladder, got {type(ladder).__name__}.")
+    LADDERS[method] = ladder
+    return ladder
+
+
+def _fe_options(scene, t_end, level):
+    from femehl.discretize.fitted import fitted_disk
+
+    return {"mesh": fitted_disk(scene, t_end, level=level)}
+
+
+def _fe_cells(scene, t_end, level):
+    return _fe_sizer(scene, t_end)(level)
+
+
+def _fe_sizer(scene, t_end):
+    from femehl.discretize.fitted import fitted_sizes
+
+    half = bool(getattr(scene.indenter, "symmetric_y", False))
+    base = fitted_sizes(scene, t_end, 1.0)  # the contact extent: the costly part (~0.4 s)
+    return lambda level: base.at_level(level).estimate_elements(half)
+
+
+#: line contact: 400 elements (the LineDisc default) at level 1
+LINE_ELEMENTS = 400
+
+
+def _line_elements(level) -> int:
+    return max(20, round(LINE_ELEMENTS / level))
+
+
+def _fe_companion(scene, options):
+    from femehl.discretize.fe_disk import FITTED, _horizon
+    from femehl.discretize.fitted import fitted_disk
+    from femehl.discretize.mesh import LADDER, LADDER_RATIO
+
+    mesh = options.get("mesh", "medium")
+    if not isinstance(mesh, str):
+        return None
+    if mesh == FITTED:
+        coarse = fitted_disk(scene, _horizon(scene), level=2.0, half=options.get("half"))
+        return {**options, "mesh": coarse}, 2.0
+    names = list(LADDER)
+    if mesh not in names or names.index(mesh) == 0:
+        return None
+    k = names.index(mesh)
+    down = min(k, 2)
+    return {**options, "mesh": names[k - down]}, LADDER_RATIO**down
+
+
+def _line_companion(scene, options):
+    n = int(options.get("n_elements", LINE_ELEMENTS))
+    return ({**options, "n_elements": n // 2}, n / (n // 2)) if n >= 40 else None
+
+
+register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion, _fe_sizer))
+register_ladder(
+    "line",
+    Ladder(
+        lambda scene, t_end, level: {"n_elements": _line_elements(level)},
+        lambda scene, t_end, level: float(_line_elements(level)),
+        ("n_elements",),
+        _line_companion,
+    ),
+)
+
+
+# ---- estimators --------------------------------------------------------------------------
+def _scale(name: str, q: np.ndarray) -> np.ndarray:
+    """The denominator of relative errors: |q|, floored at LOAD_FLOOR for the load."""
+    floor = LOAD_FLOOR if name == "load" else 0.0
+    return np.maximum(np.abs(q), floor)
+
+
+def pair_error(fine: Result, coarse: Result, name: str, ratio: float) -> np.ndarray:
+    """Relative Richardson estimate of ``fine``'s error of ``name`` on ``fine.t``.
+
+    ``coarse`` ran at ``ratio`` times the level of ``fine`` (sizes and, through
+    :func:`time_tolerance`, ``ratio**2`` times its time tolerance), so both errors scale
+    like ``ratio**2`` and ``err_fine = |q_f - q_c| / (ratio**2 - 1)``.
+    """
+    qf = getattr(fine, name)
+    qc = np.array([coarse.value_at(name, t) for t in fine.t])
+    scene = getattr(fine, "scene", None)
+    if getattr(getattr(scene, "substrate", None), "instant", False):
+        qc = _across_jumps(coarse, name, fine.t, qc, breakpoints_of(scene))
+    return np.abs(qf - qc) / (ratio**ORDER - 1.0) / _scale(name, qf)
+
+
+def _across_jumps(coarse, name, ts, qc, breaks) -> np.ndarray:
+    """``coarse``'s ``name`` at ``ts`` where it jumps at its start and at the motion's
+    ``breaks`` (a substrate whose pressure follows hc' at once): within each stretch
+    ``(a, b]`` from the coarse levels after ``a`` only, extrapolated linearly back to ``a``."""
+    tc = np.asarray(coarse.t, dtype=float)
+    q = np.array([coarse.value_at(name, t) for t in tc])
+    out = qc.copy()
+    edges = [tc[0], *sorted(b for b in breaks if tc[0] < b < tc[-1]), math.inf]
+    for a, b in itertools.pairwise(edges):
+        inside = (tc > a) & (tc <= b)
+        if inside.sum() < 2:
+            continue
+        t1, t2 = tc[inside][:2]
+        q1, q2 = q[inside][:2]
+        early = (ts > a) & (ts < t1)
+        out[early] = q1 + (ts[early] - t1) * (q2 - q1) / (t2 - t1)
+    return out
+
+
+def time_error(res: Result) -> np.ndarray:
+    """Accumulated local time errors ``sum error_estimate * max(dt, UNIT_STEP)`` per step.
+
+    From the adaptive controller's per-step ``error_estimate`` (:mod:`femehl.solver.adaptive`,
+    a local error per unit time, per UNIT_STEP below steps of UNIT_STEP) and ``dt`` of
+    every state of ``res`` (the initial state: dt = 0, no error).
+    """
+    e, dt = res.error_estimate, res.dt
+    local = np.where(np.isfinite(e) & (dt > 0), np.nan_to_num(e) * np.maximum(dt, UNIT_STEP), 0.0)
+    return np.cumsum(local)
+
+
+def companion_run(scene, method, options, t_end, dt, tol, controls) -> tuple:
+    """``(Result, ratio)`` of the coarser companion of an expert run, or ``(None, None)``.
+
+    Same time steps as the run (fixed ``dt``, or adaptive to the same ``tol``), the
+    method's :attr:`Ladder.companion` discretization.  A companion that stops (its
+    coarser mesh may not resolve the film) is logged and gives no space estimate.
+    """
+    from femehl.solver.loop import make_stepper, run_loop
+
+    ladder = LADDERS.get(method)
+    plan = ladder.companion(scene, options) if ladder is not None and ladder.companion else None
+    if plan is None:
+        return None, None
+    coarse_options, ratio = plan
+    try:
+        coarse = make_stepper(scene, method, **coarse_options)
+        return run_loop(coarse, t_end, dt, tol=tol, store_every=0, **controls), ratio
+    except SolverError as exc:
+        logger.warning("femehl: no space estimate: the coarser companion run stopped (%s)", exc)
+        return None, None
+
+
+def expert_estimate(
+    res: Result, companion: Result | None, ratio: float | None, adaptive: bool
+) -> dict | None:
+    """The estimate of an expert run (its own mesh and steps).
+
+    ``space``: the running maximum of ``|q - q_c| / (ratio**2 - 1)`` against a
+    ``companion`` run ``ratio`` times coarser in space with the same time steps (fixed
+    ``dt``, or the same tolerance), so the difference is the space error; None without a
+    companion.  ``time``: the controller's accumulated local errors (:func:`time_error`)
+    for adaptive steps, None for fixed steps.  ``total = space + time`` when both are
+    known, else None.  None when neither is.
+    """
+    if companion is None and not adaptive:
+        return None
+    et = time_error(res) if adaptive else None
+    out = {"t": res.t}
+    for name in QUANTITIES:
+        space = None
+        if companion is not None:
+            space = np.maximum.accumulate(pair_error(res, companion, name, ratio))
+        tpart = None if et is None else et.copy()
+        total = space + tpart if space is not None and tpart is not None else None
+        out[name] = {"total": total, "space": space, "time": tpart}
+    return out
+
+
+def estimate(fine: Result, coarse: Result, ratio: float) -> dict:
+    """``{"t": fine.t, name: {"total", "space", "time"}}`` for every quantity.
+
+    ``total`` is the running maximum over the steps so far of the pair estimate
+    (:func:`pair_error`, space and time together): the pair difference changes sign in
+    time, and where it crosses zero the error does not vanish, so the estimate at t is
+    that of the run up to t.  ``time`` is the accumulated local errors of ``fine``
+    (:func:`time_error`) but at most ``total``; ``space = total - time``.
+    """
+    et = time_error(fine)
+    out = {"t": fine.t}
+    for name in QUANTITIES:
+        total = np.maximum.accumulate(pair_error(fine, coarse, name, ratio))
+        tpart = np.minimum(et, total)
+        out[name] = {"total": total, "space": total - tpart, "time": tpart}
+    return out
+
+
+class CompanionSeries:
+    """The headline series of a run, as saved in a run folder (``auto.json``): ``value_at``."""
+
+    def __init__(self, record: dict):
+        self.t = np.asarray(record["t"], dtype=float)
+        self._q = {q: np.asarray(record[q], dtype=float) for q in QUANTITIES}
+        self.info = {"level": float(record["level"])}
+
+    def value_at(self, name: str, t: float) -> float:
+        return float(np.interp(t, self.t, self._q[name]))
+
+
+def companion_record(res) -> dict:
+    """What the estimate needs of the companion run (JSON-able): level and headline series."""
+    return {
+        "level": float(res.info["level"]),
+        "t": res.t.tolist(),
+        **{q: getattr(res, q).tolist() for q in QUANTITIES},
+    }
+
+
+def _worst(est: dict, part: str = "total") -> float:
+    return max(float(np.max(est[q][part])) for q in QUANTITIES)
+
+
+def _where(est: dict) -> str:
+    """``"film_min at t = 0.04"``: the quantity and time of the largest total estimate."""
+    name = max(QUANTITIES, key=lambda q: float(np.max(est[q]["total"])))
+    k = int(np.argmax(est[name]["total"]))
+    return f"{name} at t = {float(est['t'][k]):.4g}"
+
+
+# ---- the driver --------------------------------------------------------------------------
+def _run(
+    scene,
+    method,
+    ladder,
+    t_end,
+    level,
+    store_every,
+    options,
+    runner=None,
+    previous=None,
+    deadline=None,
+    progress=None,
+) -> Result:
+    """One adaptive run at ``level`` (its discretization from ``ladder``).
+
+    ``runner(level=, tol_t=, options=, previous=)`` makes the runs that may be accepted
+    (a run folder writes them as they go); the others, and all of them without a
+    runner, run in memory through the one loop (:func:`femehl.solver.loop.run_loop`).  A run in
+    memory still going at ``deadline`` (``time.perf_counter()``) raises
+    :class:`_OutOfTime`.  ``progress(desc, t_end)``, when given, makes a State handler with
+    a ``close()`` (a progress bar) for a run in memory.
+    """
+    t0 = time.perf_counter()
+    tol_t = time_tolerance(level)
+    disc = {**ladder.options(scene, t_end, level), **options}
+    if runner is not None and previous is not None:
+        res = runner(level=level, tol_t=tol_t, options=disc, previous=previous)
+    else:
+        from femehl.solver.adaptive import CONTROLS
+        from femehl.solver.loop import make_stepper, run_loop
+
+        handlers = [disc.pop("callback", None)]
+        controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
+        stepper = make_stepper(scene, method, **{"scheme": "bdf2", **disc})
+        bar = None
+        if progress is not None:
+            bar = progress(f"pilot level {level:.3g} ({stepper.info.get('elements', '?')} cells)", t_end)
+            handlers.append(bar)
+        on_state = _chain(handlers)
+        if deadline is not None:
+            on_state = _deadline_guard(deadline, on_state)
+        try:
+            res = run_loop(
+                stepper, t_end, None, tol=tol_t, store_every=store_every, on_state=on_state, **controls
+            )
+        finally:
+            if bar is not None:
+                bar.close()
+    n = int(res.info["elements"]) if "elements" in res.info else int(ladder.cells(scene, t_end, level))
+    res.info.update(level=level, elements=n, tol_t=tol_t, wall=time.perf_counter() - t0)
+    logger.info(
+        "auto: level %.3g (%d cells, time tolerance %.2g): %d steps, %.1f s",
+        level,
+        n,
+        tol_t,
+        res.nsteps,
+        res.info["wall"],
+    )
+    return res
+
+
+def _chain(handlers):
+    """One State handler calling each of ``handlers`` (None entries skipped), or None."""
+    handlers = [h for h in handlers if h is not None]
+    if not handlers:
+        return None
+    if len(handlers) == 1:
+        return handlers[0]
+
+    def each(state):
+        for h in handlers:
+            h(state)
+
+    return each
+
+
+def companion_to(scene, method, t_end, t_fit, level, store_every, options) -> Result:
+    """The companion run of a resumed automatic run again, to a later ``t_end``: ``level``'s
+    discretization fitted to ``t_fit`` (the first run's end, as the candidate's mesh)."""
+    ladder = LADDERS[method]
+    fitted = Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
+    return _run(scene, method, fitted, t_end, level, 0, dict(options))
+
+
+def _next_level(level: float, err: float, tol: float) -> float:
+    """The level predicted to bring the error to SAFETY * tol, within RATIO_RANGE of ``level``."""
+    lo, hi = RATIO_RANGE
+    ratio = hi if not np.isfinite(err) or err <= 0 else math.sqrt(err / (SAFETY * tol))
+    return level / min(hi, max(lo, ratio))
+
+
+def budget_level(cells, previous: float, wanted: float, max_elements: int, fits=None):
+    """The finest level whose cells fit ``max_elements``, between ``wanted`` (the level the
+    estimate asks for, over the budget) and ``previous`` (the last run's level), if it is
+    at least :data:`BUDGET_RATIO` finer than ``previous``; else None.
+
+    By bisection in ``log(level)`` on ``cells(level)`` (:meth:`Ladder.cells_of`, nothing
+    is built): the budget
+    still buys one more run, whose pair estimate (ratio >= BUDGET_RATIO to the last run)
+    is the one returned.  ``fits(level) -> bool``, when given, must hold as well (the
+    time budget: :func:`predicted_wall`); it must be true on coarser levels if on a finer one.
+    """
+    within = fits if fits is not None else (lambda lv: True)
+    fits = lambda lv: cells(lv) <= max_elements and within(lv)  # noqa: E731
+    lo, hi = math.log(previous / BUDGET_RATIO), math.log(wanted)
+    if hi >= lo or not fits(math.exp(lo)):
+        return None
+    for _ in range(BUDGET_BISECTIONS):  # lo fits, hi does not
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fits(math.exp(mid)) else (lo, mid)
+    return math.exp(lo)
+
+
+#: exponent of the cost per step in the cells when the last two runs do not give it (one
+#: run: between the dense path's 2 and the rest's 1.1), and the range the fitted one is
+#: kept in: a fast or sparse step costs about cells^1.1, a dense one cells^2
+#: (``benchmarks/fast_operator.md``), while small runs, whose cost is mostly overhead, fit
+#: below 1 and the switch to the fast operator (set-up, compilation) costs more than
+#: either.  Replayed on the 147 recorded level changes of the auto and stress_auto
+#: benchmarks (``benchmarks/time_budget.md``), predicted / actual wall time: median 2.03,
+#: 0.45 to 18.7 (the pilots after the first run, which compiles); over the 76 runs
+#: longer than 20 s median 1.70, 0.45 to 6.6 (the thin films at beta = 20000, whose steps
+#: grow less than the level ratio), under 1 in 13 (most near the switch to the fast
+#: operator).  With the range (1, 2), on the auto runs alone: median 1.35 over 20 s, but
+#: under 1 in 11 of 32 (5 of 32 with this range).
+COST_EXPONENT = 1.5
+COST_EXPONENT_RANGE = (1.3, 2.0)
+
+
+def predicted_wall(runs, cells: float, level: float) -> float:
+    """The wall time (s) of a run at ``level`` with ``cells`` cells, from the finished ``runs``.
+
+    Steps: the last run's times ``r = last level / level`` (adaptive BDF2 at ``tol_t``
+    proportional to ``level**2`` takes steps proportional to ``1 / level``; measured
+    ratios 1.6 to 1.85 per halving on the paper case).  Cost per step (set-up included):
+    the last run's times ``(cells / its cells)**e``, ``e`` fitted on the last two runs'
+    costs per step and kept in :data:`COST_EXPONENT_RANGE`, :data:`COST_EXPONENT` with
+    one run.  ``runs`` carry ``info["elements"]``, ``info["wall"]``, ``info["level"]``
+    and ``nsteps``.
+    """
+    last = runs[-1]
+    n1, w1, s1 = float(last.info["elements"]), float(last.info["wall"]), max(1, last.nsteps)
+    e = COST_EXPONENT
+    if len(runs) >= 2:
+        prev = runs[-2]
+        n0, w0, s0 = float(prev.info["elements"]), float(prev.info["wall"]), max(1, prev.nsteps)
+        if n1 > 1.05 * n0 and w0 > 0.0 and w1 > 0.0:
+            e = math.log((w1 / s1) / (w0 / s0)) / math.log(n1 / n0)
+            e = min(COST_EXPONENT_RANGE[1], max(COST_EXPONENT_RANGE[0], e))
+    ratio = float(last.info["level"]) / level
+    return w1 * (max(cells, 1.0) / n1) ** e * ratio
+
+
+def check_max_wall(max_wall) -> float | None:
+    """The automatic mode's time budget: None or a positive number of seconds."""
+    if max_wall is None:
+        return None
+    if isinstance(max_wall, bool) or not isinstance(max_wall, int | float) or not (0 < max_wall < math.inf):
+        raise SceneError(
+            f"max_wall must be a positive number of seconds (or None: no limit), got {max_wall!r}."
+        )
+    return float(max_wall)
+
+
+class _OutOfTime(Exception):
+    """A run held in memory was still going at the deadline of ``max_wall``."""
+
+    def __init__(self, t: float):
+        super().__init__(t)
+        self.t = t
+
+
+def _deadline_guard(deadline: float, callback):
+    """A state callback that calls ``callback`` and stops the run past ``deadline``."""
+
+    def guard(state):
+        if callback is not None:
+            callback(state)
+        if time.perf_counter() > deadline:
+            raise _OutOfTime(float(state.t))
+
+    return guard
+
+
+def cell_budget(scene, max_elements: int | None = None) -> int:
+    """The automatic mode's cell budget: ``max_elements``, or by default
+    :data:`LOCAL_MAX_ELEMENTS` when the scene's substrate has sparse operators only
+    (``substrate.local``), :data:`FAST_MAX_ELEMENTS` when it has the fast hierarchical
+    operator (``"fast"`` in ``substrate.operators``, the default) and
+    :data:`MAX_ELEMENTS` when its operator is dense only (a layer)."""
+    if max_elements is None:
+        from femehl.elastic.base import substrate_operators
+
+        sub = getattr(scene, "substrate", None)  # None: a line contact's own foundation
+        if getattr(sub, "local", False):
+            return LOCAL_MAX_ELEMENTS
+        if sub is not None and "fast" in substrate_operators(sub):
+            return FAST_MAX_ELEMENTS
+        return MAX_ELEMENTS
+    if isinstance(max_elements, bool) or not isinstance(max_elements, int) or max_elements < 1:
+        raise SceneError(f"max_elements must be a positive integer (cells), got {max_elements!r}.")
+    return max_elements
+
+
+def solve_to_tolerance(
+    scene,
+    *,
+    t_end: float,
+    tol: float = 1e-2,
+    method: str | None = None,
+    store_every: int = 1,
+    max_elements: int | None = None,
+    max_wall: float | None = None,
+    level: float = LEVEL0,
+    runner=None,
+    on_run: Callable[[Result], None] | None = None,
+    progress=None,
+    **options,
+) -> Result:
+    """Run ``scene`` to ``t_end`` with the load and films to about ``tol`` relative.
+
+    Returns the finest run (a :class:`~femehl.output.result.Result`) with ``result.estimate``
+    (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
+    ``reached`` (the estimate is <= :data:`ACCEPT` * ``tol``), ``accept``, ``stopped``
+    (None, ``"cell budget"`` or ``"time budget"``: what ended a sequence that did not
+    reach ``tol``), ``levels``, ``elements``, ``steps``,
+    ``rejected_steps``, ``tol_t`` and ``wall`` of every run, and the largest estimated
+    ``total``, ``space`` and ``time`` errors.  ``level`` is the first (coarsest) level;
+    ``max_elements`` the cell budget (default: :func:`cell_budget` of the scene's
+    substrate); ``max_wall`` a time budget in seconds for the whole sequence (default:
+    none; see the module docstring); ``options`` go to
+    :func:`femehl.solve` (not the discretization's,
+    nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run;
+    ``on_run(result)`` with every finished run, pilots included (its scalars stay; its
+    fields are dropped once a finer run supersedes it); ``progress(desc, t_end)`` makes
+    a progress handler (a State callable with ``close()``) for each run in memory.
+    """
+    from femehl.solver.loop import _registry
+
+    method = scene.default_method if method is None else method
+    if method not in LADDERS:
+        known = sorted(_registry())
+        raise SceneError(
+            f"method {method!r} has no refinement ladder, so it cannot choose its own "
+            f"discretization; automatic methods: {sorted(LADDERS)} (all: {known}). "
+            "Give its discretization options and dt (or tol for the time steps) instead."
+        )
+    if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
+        raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
+    if on_run is not None and not callable(on_run):
+        raise SceneError(f"on_run must be a function of a finished run (a Result), got {on_run!r}.")
+    ladder = LADDERS[method]
+    max_elements = cell_budget(scene, max_elements)
+    max_wall = check_max_wall(max_wall)
+    deadline = None if max_wall is None else time.perf_counter() + max_wall
+    cells = ladder.cells_of(scene, t_end)
+    for key in ("dt_max", "dt", *ladder.keys):
+        if key in options:
+            raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
+
+    def in_time(lv: float) -> bool:
+        """A run at ``lv`` is predicted to finish before the deadline (always without one)."""
+        if deadline is None:
+            return True
+        left = deadline - time.perf_counter()
+        return left > 0.0 and (not runs or predicted_wall(runs, cells(lv), lv) <= left)
+
+    runs, est, reached, err = [], None, False, math.nan
+    fine, failed, last, stopped = None, None, False, None
+    while True:
+        ne = cells(level)
+        over_cells = ne > max_elements
+        if (runs or failed) and (over_cells or not in_time(level)):
+            fit = cell_fit = None
+            if runs and not last:
+                fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
+                cell_fit = (
+                    fit
+                    if deadline is None
+                    else budget_level(cells, runs[-1].info["level"], level, max_elements)
+                )
+            # the budget that binds: time, when the cells alone are not exceeded or allow a
+            # finer level than the time does (beyond the bisection's 1 %)
+            time_binds = not over_cells or (cell_fit is not None and (fit is None or cell_fit < fit / 1.02))
+            why = "time budget" if time_binds else "cell budget"
+            if fit is None:
+                logger.info("auto: level %.3g (~%.0f cells) is over the %s: stop", level, ne, why)
+                stopped = why
+                if failed is not None and not runs:
+                    if why == "time budget":
+                        raise TimeBudgetError(
+                            f"no run finished within max_wall = {max_wall:g} s: the film closed on the "
+                            f"coarser meshes ({failed}). Give a larger max_wall.",
+                            t=failed.t,
+                        ) from failed
+                    raise failed  # no level within the budget got through
+                break
+            logger.info(
+                "auto: level %.3g (~%.0f cells) is over the %s: a run at level %.3g, the finest within it",
+                level,
+                ne,
+                why,
+                fit,
+            )
+            # the cell budget's fit is the finest level there is; the time budget's is
+            # asked again after the run (a run cheaper than predicted leaves time for more)
+            level, last, stopped = fit, why == "cell budget", why
+        candidate = len(runs) >= MIN_RUNS - 1
+        previous = runs[-1] if candidate else None
+        try:
+            res = _run(
+                scene,
+                method,
+                ladder,
+                t_end,
+                level,
+                store_every,
+                options,
+                runner,
+                previous,
+                deadline,
+                progress,
+            )
+        except _OutOfTime as exc:
+            stopped = "time budget"
+            if not runs:
+                raise TimeBudgetError(
+                    f"no run finished within max_wall = {max_wall:g} s: the first, at level {level:.3g} "
+                    f"(~{ne:.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. Give a larger "
+                    "max_wall, or a coarser first level (level=).",
+                    t=exc.t,
+                ) from None
+            logger.warning(
+                "auto: max_wall = %g s reached at t = %.4g of the run at level %.3g: it is abandoned, "
+                "the answer is the last finished run",
+                max_wall,
+                exc.t,
+                level,
+            )
+            break
+        except SolverError as exc:
+            if getattr(exc, "where", None) is None:
+                raise  # not a film that closes or a step floor: nothing a finer mesh changes
+            failed = _closing_confirmed(failed, exc, level, t_end)
+            level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
+            continue
+        if runs:
+            ratio = runs[-1].info["level"] / level
+            est = estimate(res, runs[-1], ratio)
+            err = _worst(est)
+            logger.info("auto: estimated error %.3g (%s), level ratio %.3g", err, _where(est), ratio)
+        if fine is not None:
+            fine._stored.clear()  # superseded: its scalars stay (the companion), its fields go
+        fine = res
+        runs.append(res)
+        if on_run is not None:
+            on_run(res)
+        if len(runs) >= MIN_RUNS and err <= ACCEPT * tol:
+            reached = True
+            break
+        if last:
+            break
+        level = _next_level(level, err, tol) if len(runs) >= 2 else level / 2.0
+    return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall)
+
+
+#: two runs whose films close within this fraction of t_end of each other, and within
+#: CLOSE_DISTANCE of each other in space, confirm that the film really closes
+CLOSE_TIME, CLOSE_DISTANCE = 0.05, 0.2
+#: ... if the finer one's film fell steadily to zero, or below this fraction of the initial film
+CLOSED_FILM = 1e-3
+
+
+def _closing_confirmed(earlier, exc, level, t_end):
+    """Raise ``exc`` if a coarser run closed its film at about the same time and place.
+
+    A film that closes on one mesh may only be unresolved there (a coarse pilot at a
+    thin exit); the next level, twice as fine, decides.  The closing is confirmed when
+    this run's film really closes (``reason == "closes"``: it fell steadily to zero; or
+    the step floor was reached with the film below CLOSED_FILM times the initial film),
+    at a level <= 1 (not a pilot), within CLOSE_TIME * t_end and CLOSE_DISTANCE of the
+    previous failure.  Returns ``exc`` (with the level recorded)
+    to remember for that comparison.
+    """
+    exc.level = level
+    logger.info(
+        "auto: the film closed at level %.3g (t = %.4g at %s): trying a finer mesh", level, exc.t, exc.where
+    )
+    d_min, film0 = getattr(exc, "d_min", math.nan), getattr(exc, "film0", math.nan)
+    closed = getattr(exc, "reason", "closes") == "closes" or d_min <= CLOSED_FILM * film0
+    if earlier is not None and closed and level <= 1.0:
+        dt = abs(float(exc.t) - float(earlier.t))
+        dx = float(np.hypot(*(np.asarray(exc.where, float) - np.asarray(earlier.where, float))))
+        if dt <= CLOSE_TIME * t_end and dx <= CLOSE_DISTANCE:
+            exc.args = (
+                f"{exc.args[0]} The film closed at about the same time and place on two meshes "
+                f"(levels {earlier.level:.3g} and {level:.3g}), the finer one to {d_min:.3g} "
+                f"({d_min / film0:.2g} of the initial film): it really closes.",
+                *exc.args[1:],
+            )
+            raise exc
+    return exc
+
+
+def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -> Result:
+    """Attach the estimate and the summary of the runs; warn when tol was not reached."""
+    res.estimate = est
+    info = {
+        "tol": tol,
+        "reached": reached,
+        "accept": ACCEPT,
+        "stopped": stopped,
+        "max_wall": max_wall,
+        "levels": [r.info["level"] for r in runs],
+        "elements": [r.info["elements"] for r in runs],
+        "steps": [r.nsteps for r in runs],
+        "rejected_steps": [r.info.get("rejected_steps") for r in runs],
+        "tol_t": [r.info["tol_t"] for r in runs],
+        "wall": [r.info["wall"] for r in runs],
+    }
+    if est is not None:
+        info.update({part: _worst(est, part) for part in ("total", "space", "time")})
+    res.info["auto"] = info
+    if not reached:
+        worst = "unknown (one level only)" if est is None else f"{info['total']:.3g}"
+        cells = max(info["elements"])
+        within = f"max_wall = {max_wall:g} s" if stopped == "time budget" else f"{cells} cells"
+        logger.warning(
+            "solve_to_tolerance: tolerance %g not reached within %s: estimated error %s (accepted at "
+            "<= %g tol)",
+            tol,
+            within,
+            worst,
+            ACCEPT,
+        )
+    return res

@@ -1,0 +1,369 @@
+"""Line contact: a rigid cylinder sliding on a Winkler foundation (paper section 4).
+
+The problem
+-----------
+The cylinder's gap is ``s(x) = x^2/2`` (normalized units, radius 1), or any rigid
+gap profile ``s(x)`` the scene is given (``LineScene(profile=...)``: a textured or
+inclined slider), the substrate a Winkler foundation ``w = -p/k``, and the film
+thickness
+
+    d(x, t) = hc(t) + s(x) + p(x, t)/k            (d = h - w, w < 0 under p > 0)
+
+obeys the 1-D normalized Reynolds equation, with the same conventions as the
+2-D problem of :mod:`femehl.problem.scene` (docs/design.md, sections 1-2):
+
+    beta d/dx( d^3 dp/dx ) = -V(t) dd/dx + dd/dt      on -L < x < L,
+    p(-L) = p(L) = 0,    p(x, 0) = 0  so  d(x, 0) = hc(0) + s(x).
+
+The cylinder slides toward +x; in its frame the substrate moves toward -x,
+so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
+gap, hc < 0 an indentation.  Without a cavitation condition (full Sommerfeld) p may
+go negative (at the exit), as in the 2-D solvers; ``cavitation="jfo"``, ``"reynolds"`` or
+``"half-sommerfeld"`` as there (:mod:`femehl.solver.cavitation`).  The paper checks its scheme on this
+problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
+steady sliding solution, which :mod:`femehl.reference.line_steady` computes by
+quadrature and shooting.
+
+The scheme (paper section 3, femehl's FE form, docs/design.md, section 4)
+-------------------------------------------------------------------------
+P1 pressure on a scikit-fem :class:`~skfem.MeshLine` (uniform or graded),
+the film on elements (P0): ``d_e = h(x_e) + (P p)_e / k`` with ``x_e`` the
+centroid and ``P`` the element average of a P1 field.  With ``d^3`` lagged
+one step, find p^{k+1} in P1, p = 0 at x = +-L, such that for every P1 test
+function q vanishing at +-L
+
+    beta int (d^k)^3 p' q'  +  V int d^{k+1} q'  +  int (d^{k+1} - d^k)/dt q  = 0
+
+(the Couette term integrated by parts; its boundary term vanishes since
+q(+-L) = 0).  With ``C = P/k`` (sparse: the Winkler foundation is local) this
+is ONE sparse linear system per step,
+
+    ( beta K(d^k) + V Bx C + M C/dt ) p = -V Bx h^{k+1} - M (h^{k+1} - d^k)/dt,
+
+with the forms of :mod:`femehl.discretize.forms` (K: ``film_diffusion``, Bx:
+``couette``, M: ``squeeze``).  No dense matrix is built anywhere.
+
+Imposed load per unit length ``F(t)`` instead of an imposed gap: hc^{k+1} is
+one more unknown (its column is ``V Bx 1 + M 1/dt``) and the row
+``int p dx = F(t^{k+1})`` borders the system; still one sparse solve per step,
+and the load is met to solver precision at every step.  ``motion.gap`` then
+only sets the initial clearance hc(0) (as for the 2-D solvers).
+
+``scheme="bdf2"`` (see :data:`femehl.solver.stepping.SCHEMES`) replaces the backward
+Euler difference by BDF2 and the lagged d^k by the extrapolation
+``2 d^k - d^{k-1}`` (variable-step forms); still one linear system per step.
+At a steady state (d^{k+1} = d^k = d^{k-1}) either scheme reduces to the
+steady weak form whatever dt, so long runs test the spatial discretization
+alone.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from femehl.elastic import Winkler
+from femehl.errors import SceneError
+from femehl.problem.scene import (
+    Constant,
+    Fluid,
+    Motion,
+    RampHold,
+    SceneEffects,
+    Table,
+    TanhStart,
+    _as_time_function,
+    check_finite,
+    check_positive,
+)
+from femehl.validation import check_shape_values
+
+__all__ = ["LineScene", "line_nodes"]
+
+
+def _default_motion() -> Motion:
+    return Motion(gap=RampHold(0.1, -0.5, 1.0), velocity=TanhStart(1.0, 1.0))
+
+
+# --------------------------------------------------------------------------
+# scene
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LineScene(SceneEffects):
+    """A rigid cylinder (gap ``x^2/2``, or a given profile) on a lubricated Winkler foundation.
+
+    Normalized units (module docstring).
+
+    Parameters
+    ----------
+    k : float, default: 1.0
+        Winkler stiffness, ``w = -p/k`` (> 0; a large k is a nearly rigid substrate).
+    beta : float, default: 10.0
+        The paper's film parameter multiplying ``d/dx(d^3 dp/dx)`` (> 0).
+    motion : femehl.problem.scene.Motion, default: ramp 0.1 -> -0.5 for t <= 1, then tanh(t - 1) sliding
+        Tip clearance hc(t) and sliding velocity V(t) (cylinder moves toward +x).
+        With an imposed load, ``motion.gap`` only gives the initial clearance hc(0).
+    L : float, default: 2.0
+        Half length of the domain ``[-L, L]``; p = 0 at both ends.
+    load : callable or float or None, default: None
+        Imposed load per unit length ``F(t) = int p dx``; None imposes the gap
+        instead.  ``motion.load`` is accepted too (and moved here); give one of them.
+    viscosity : femehl.Barus or femehl.Roelands, optional
+        Pressure-dependent viscosity (:mod:`femehl.problem.viscosity`); None: isoviscous.
+    cavitation : {None, "jfo", "reynolds", "half-sommerfeld"}, optional
+        Cavitation condition (:mod:`femehl.solver.cavitation`); None: full Sommerfeld.
+    viscoelastic : femehl.Viscoelastic, optional
+        A viscoelastic foundation: the standard linear solid whose relaxed stiffness is
+        ``k * G_inf`` and unrelaxed ``k * G0`` (its ``elastic`` is the Winkler(k) of this
+        scene; :mod:`femehl.elastic.viscoelastic`); None: elastic.
+    profile : callable, optional
+        The rigid gap ``s(x)`` of the slider, a vectorized function of an array of x
+        returning one finite value per point (e.g. a textured slider,
+        ``lambda x: 0.1 * x + pocket(x)``); the film is ``d = hc + s(x) + p/k``.  It must
+        leave the film open at the start: ``s(x) + hc(0) > 0`` on [-L, L].  None: the
+        cylinder ``x^2/2``.  A callable cannot be written in a scene file.
+    """
+
+    default_method = "line"
+
+    k: float = 1.0
+    beta: float = 10.0
+    motion: Motion = field(default_factory=_default_motion)
+    L: float = 2.0
+    load: Callable[[float], float] | None = None
+    viscosity: object = field(default=None, metadata={"describe": "omit_default"})
+    cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
+    viscoelastic: object = field(default=None, metadata={"describe": "omit_default"})
+    profile: Callable | None = field(default=None, metadata={"describe": "omit_default"})
+
+    def __post_init__(self):
+        from femehl.problem.viscosity import check_viscosity
+        from femehl.solver.cavitation import check_cavitation
+
+        check_viscosity(self.viscosity)
+        check_cavitation(self.cavitation)
+        from femehl.elastic import Viscoelastic
+
+        if self.viscoelastic is not None and not isinstance(self.viscoelastic, Viscoelastic):
+            raise SceneError(
+                f"LineScene(viscoelastic=...) must be a femehl.Viscoelastic(G0, tau), got "
+                f"{type(self.viscoelastic).__name__}."
+            )
+        object.__setattr__(
+            self,
+            "k",
+            check_positive("Winkler stiffness k", self.k, "Use a large k for a nearly rigid substrate."),
+        )
+        object.__setattr__(
+            self,
+            "beta",
+            check_positive("beta", self.beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation."),
+        )
+        object.__setattr__(
+            self,
+            "L",
+            check_positive("domain half length L", self.L, "The domain is [-L, L]; L = 2 suits hc >= -0.5."),
+        )
+        if not isinstance(self.motion, Motion):
+            raise SceneError(
+                f"LineScene.motion must be a femehl.problem.scene.Motion, got {type(self.motion).__name__}: "
+                "wrap the gap and velocity as Motion(gap=..., velocity=...)."
+            )
+        mload = getattr(self.motion, "load", None)
+        if mload is not None:
+            if self.load is not None:
+                raise SceneError("the load is imposed twice (LineScene.load and Motion.load): give only one.")
+            object.__setattr__(self, "load", mload)
+        if self.load is not None:
+            object.__setattr__(self, "load", _as_time_function("LineScene load F(t)", self.load))
+            check_finite("load F(t=0)", self.load(0.0), "The load history must return finite values.")
+            object.__setattr__(
+                self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity, load=self.load)
+            )
+            times = np.union1d(np.linspace(0.0, 10.0, 201), getattr(self.load, "times", ()))
+            for t in times[times >= 0.0]:
+                self.motion.F(t)  # refuses a negative (pulling) load up front, naming the time
+        hc0 = self.motion.hc(0.0)
+        if self.profile is not None:
+            self._check_profile(hc0)
+        elif hc0 <= 0.0:
+            raise SceneError(
+                f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
+                "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
+                "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
+            )
+        from femehl.solver.cavitation import check_cavitation_scene
+
+        check_cavitation_scene(self)
+        a = self.contact_halfwidth()
+        if a is not None and self.L < 1.5 * a:
+            raise SceneError(
+                f"domain half length L = {self.L:g} is too small to hold the contact: the dry "
+                f"Winkler contact of this run reaches |x| = {a:.3g}, and the pressure must decay "
+                f"before x = +-L. Use L >= {1.5 * a:.3g}."
+            )
+
+    @property
+    def fluid(self) -> Fluid:
+        """The film's fluid (its ``beta``), as for a 2-D scene."""
+        return Fluid(self.beta)
+
+    @property
+    def substrate(self):
+        """The Winkler foundation ``w = -p/k`` (relaxing as ``viscoelastic`` says, if given)."""
+        if self.viscoelastic is None:
+            return Winkler(self.k)
+        return dataclasses.replace(self.viscoelastic, elastic=Winkler(self.k))
+
+    @property
+    def imposed_load(self) -> bool:
+        """True when the load F(t) is imposed (hc is then an unknown)."""
+        return self.load is not None
+
+    def _check_profile(self, hc0: float) -> None:
+        """SceneError unless ``profile`` is a vectorized, finite gap leaving the film open at t = 0."""
+        if not callable(self.profile):
+            raise SceneError(
+                f"LineScene(profile=...) must be a callable s(x) (the rigid gap), got "
+                f"{type(self.profile).__name__}: pass e.g. profile=lambda x: 0.5 * x**2, or None "
+                "for the cylinder."
+            )
+        xs = np.linspace(-self.L, self.L, 1001)
+        s = self._profile_values(xs)
+        if not np.all(np.isfinite(s)):
+            bad = xs[~np.isfinite(s)][0]
+            raise SceneError(
+                f"LineScene profile s(x) is not finite at x = {bad:.4g}: the rigid gap must be "
+                f"finite on the whole domain [-{self.L:g}, {self.L:g}]."
+            )
+        i = int(np.argmin(s))
+        if s[i] + hc0 <= 0.0:
+            raise SceneError(
+                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= 0 at x = {xs[i]:.4g}: with p = 0 at "
+                f"t = 0 the film must be open everywhere on [-L, L]. Start with hc(0) > {-s[i]:g} "
+                "(and indent with a ramp), or raise the profile."
+            )
+
+    def _profile_values(self, x: np.ndarray) -> np.ndarray:
+        """``profile(x)`` as a new float array of x's shape (SceneError naming the fix)."""
+        try:
+            v = self.profile(x)
+        except SceneError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - the user's code: say which function failed
+            raise SceneError(
+                f"LineScene profile s(x) raised {type(exc).__name__} on an array of x ({exc}): "
+                "it must accept a numpy array and return one value per point (vectorize with numpy)."
+            ) from None
+        v = np.asarray(v)
+        if v.shape != x.shape:
+            raise SceneError(
+                f"LineScene profile s(x) returned shape {v.shape} for x of shape {x.shape}: "
+                "return one value per point (vectorize with numpy, e.g. 0 * x + c for a constant)."
+            )
+        return check_shape_values("LineScene profile s(x)", v, x.shape)
+
+    def shape(self, x):
+        """Rigid gap ``s(x)``: the scene's ``profile``, or the cylinder's ``x^2/2``."""
+        x = np.asarray(x, dtype=float)
+        if self.profile is None:
+            return 0.5 * x * x
+        return self._profile_values(x)
+
+    def contact_halfwidth(self) -> float | None:
+        """Largest dry (Hertz-Winkler) contact half width of the run, when it can be told.
+
+        Imposed gap: ``a = sqrt(-2 hc_min)`` (0 if the gap stays open).  Imposed
+        load: ``F = (2/3) k a^3``.  None for gap or load histories that are
+        arbitrary callables, and for a user ``profile`` (the estimate is the cylinder's).
+        """
+        if self.profile is not None:
+            return None
+        if self.load is None:
+            gap = self.motion.gap
+            if isinstance(gap, RampHold):
+                hmin = min(gap.h0, gap.h_end)
+            elif isinstance(gap, Table):
+                hmin = min(gap.values)
+            elif isinstance(gap, Constant):
+                hmin = gap.value
+            else:
+                return None
+            return math.sqrt(2.0 * max(0.0, -hmin))
+        F = self.load
+        if isinstance(F, Constant):
+            fmax = F.value
+        elif isinstance(F, Table):
+            fmax = max(F.values)
+        else:
+            return None
+        return (1.5 * max(0.0, fmax) / self.k) ** (1.0 / 3.0)
+
+
+# --------------------------------------------------------------------------
+# mesh
+# --------------------------------------------------------------------------
+def line_nodes(L: float, n_elements: int, grading="uniform", fine: float | None = None):
+    """Node coordinates of a 1-D mesh of ``[-L, L]`` with ``n_elements`` elements.
+
+    Parameters
+    ----------
+    L : float
+        Half length of the domain.
+    n_elements : int
+        Number of elements (>= 4).
+    grading : "uniform", float or callable, default: "uniform"
+        "uniform": equal elements.  A float ``r >= 1``: elements are ``r`` times
+        smaller in ``|x| <= fine`` than near the ends, with a linear change of
+        the node density over a width ``0.25 L`` outside that zone.  A callable
+        ``rho(x) > 0``: node density (element size proportional to ``1/rho``).
+        The nodes are the quantiles of the density, so doubling ``n_elements``
+        halves every element (clean refinement studies).
+    fine : float, optional
+        Half width of the fine zone for a float ``grading``; default ``L/2``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``n_elements + 1`` increasing node coordinates, ``-L`` and ``L`` included.
+    """
+    L = check_positive("domain half length L", L)
+    if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) or n_elements < 4:
+        raise SceneError(f"n_elements must be an integer >= 4, got {n_elements!r}.")
+    n = int(n_elements)
+    if isinstance(grading, str):
+        if grading != "uniform":
+            raise SceneError(
+                f"grading must be 'uniform', a size ratio >= 1 or a density function, got {grading!r}."
+            )
+        return np.linspace(-L, L, n + 1)
+    if callable(grading):
+        rho = grading
+    else:
+        r = check_finite(
+            "grading (size ratio)", grading, "Give 'uniform', a ratio >= 1 or a density function rho(x)."
+        )
+        if r < 1.0:
+            raise SceneError(f"grading ratio must be >= 1 (fine/coarse element size), got {r:g}.")
+        xf = 0.5 * L if fine is None else check_positive("fine zone half width", fine)
+        width = 0.25 * L
+
+        def rho(x):
+            u = np.clip((np.abs(x) - xf) / width, 0.0, 1.0)
+            return r + (1.0 - r) * u
+
+    xs = np.linspace(-L, L, 200 * n + 1)
+    try:
+        dens = np.asarray(rho(xs), dtype=float) * np.ones_like(xs)
+    except Exception as exc:  # noqa: BLE001 - a user callable may fail any way
+        raise SceneError(f"the grading density rho(x) failed on an array of x: {exc}") from None
+    if not (np.all(np.isfinite(dens)) and np.all(dens > 0.0)):
+        raise SceneError("the grading density rho(x) must be finite and > 0 on [-L, L].")
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(xs))])
+    x = np.interp(np.linspace(0.0, cum[-1], n + 1), cum, xs)
+    x[0], x[-1] = -L, L
+    return x

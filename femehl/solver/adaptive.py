@@ -1,0 +1,563 @@
+"""Adaptive time steps for the lagged stepper: still ONE linear system per trial step.
+
+:func:`march_adaptive` walks time like :func:`femehl.solver.stepping.march` (a generator: the
+initial state, then every accepted state) but chooses each step from a local error
+estimate.  Nothing is iterated: a trial step is one call of ``stepper.step`` (one lagged
+linear solve, no side effect on the state), and a rejected trial is simply discarded.
+
+Estimator (Milne's device)
+--------------------------
+Before a step of size ``h`` from ``t_n`` the film is predicted by explicit polynomial
+extrapolation of the last accepted levels, and the local error of the step is a fixed
+multiple of the difference between the solution and that prediction:
+
+* BDF2 (order 2): quadratic predictor through ``t_{n-2}, t_{n-1}, t_n``.  With
+  ``h1 = t_n - t_{n-1}``, ``h2 = t_{n-1} - t_{n-2}``, ``omega = h/h1`` and the leading
+  BDF2 coefficient ``a0 = (1 + 2 omega)/(1 + omega)``, the variable-step local error is
+  ``y''' h^2 (h + h1) / (6 a0)`` and the predictor's ``y''' h (h + h1)(h + h1 + h2) / 6``,
+  so ``LTE ~ c (d - d_pred)`` with ``c = (h/a0) / (h/a0 + h + h1 + h2)`` (2/11 at
+  constant step).
+* backward Euler (order 1, ``scheme="euler"``): linear predictor through
+  ``t_{n-1}, t_n``, ``c = h / (2 h + h1)`` (1/3 at constant step).
+
+The coefficients of the scheme are lagged (extrapolated) too; that part of the local
+error is of the same order in ``h`` but not proportional to ``y'''``.  The estimate does
+not separate it; the tests measure the resulting global error against a fine fixed-step
+run (see ``tests/test_adaptive.py``).
+
+Norm
+----
+Relative, in the max norm over the film points, with the load as one more component,
+and per unit time::
+
+    err = c * max( max_i |d_i - d_pred_i| / d_i ,  |F - F_pred| / max(max|F|, 0.1) ) / max(h, 0.01)
+
+``d_i > 0`` is the trial film at film point i (a trial with a film <= 0 is rejected
+before), ``F`` the load and ``max|F|`` the largest load of the run so far; the floor
+``LOAD_FLOOR = 0.1`` (loads are O(0.1 .. 1) in the paper's normalization) keeps a load
+growing from 0 from having an infinite relative error at t = 0.  Dividing by ``h`` makes
+``tol`` a relative error per unit (normalized) time, so the global error follows ``tol``
+(measured: about 0.3 to 1 times tol, tests/test_adaptive.py) instead of growing with the
+number of steps.  Below ``UNIT_STEP = 0.01`` the division is by 0.01 (error per step of
+that length): an error per unit time cannot be met in the stiff initial layer of the
+film (time scale ~ 1e-6, amplitude ~ 1e-6), whose whole error is that small.
+
+Controller
+----------
+A trial is accepted when ``err <= tol``.  Either way the next step is
+``dt_new = dt * min(fac_max, max(fac_min, safety * (tol/err)^(1/q)))`` with ``q = p``
+(the order: ``err ~ h^p`` per unit time) for ``h >= UNIT_STEP`` and ``q = p + 1`` below,
+``fac_min = 0.2`` and ``fac_max = 2`` (variable-step BDF2 is zero-stable for step ratios
+below 1 + sqrt 2); no growth on the step right after a rejection, a cut by ``fac_min`` on a
+second consecutive rejection of the same step (the estimate is then not asymptotic, as
+when the contact edge sweeps over an element), and a growth factor below ``hold = 1.5``
+keeps ``dt`` (a new ``dt`` makes the gmres solver refactor its preconditioner, and a
+steady ``dt`` keeps the estimate smooth).  ``dt`` stays in ``[dt_min, dt_max]``.  When
+steady (``err -> 0``) steps grow by ``fac_max`` up to ``dt_max``.
+
+Start, breakpoints and restarts
+-------------------------------
+The first step has no history: it is a backward-Euler step (the scheme's own first step)
+of size ``dt0``.  Its error ``h1^2 y''/2`` is judged after the second step, from the
+second difference of the three levels: with ``d_lin`` the linear extrapolation of
+``d0, d1`` to ``t2``, ``LTE_1 = h1^2 / (h2 (h1 + h2)) * |d2 - d_lin|`` in the norm above
+(``err_1 = LTE_1 / max(h1, UNIT_STEP)``, order p = 1 in the controller).
+The pair (Euler step, first BDF2 step) is accepted or rejected together on ``err_1``
+(the step-1 state is yielded only then), and ``err_1`` is the ``error_estimate`` of both.
+Steps never cross a breakpoint of the motion (:attr:`femehl.problem.scene.Motion.breakpoints`:
+the end of the indentation ramp, the start of sliding, table times): a step lands
+exactly on it, and since the derivatives of the solution jump there the history is
+dropped (``d_prev = None``: the next step is a backward-Euler start again) and the step
+restarts from ``min(dt, dt0)``.  A resumed run (``start``) restarts the same way.  On a
+substrate whose pressure follows the motion at once (``substrate.instant``: a rigid one,
+where p is algebraic in hc'), the load jumps at such a (re)start: that jump is no time
+error, so the load is judged from the levels after it only (the film from all of them).
+
+Failures
+--------
+A trial step that raises :class:`~femehl.errors.FilmRuptureError` or
+:class:`~femehl.errors.SingularSystemError`, or whose film is <= 0 anywhere
+(:func:`femehl.solver.stepping.film_positive`: film points, origin, probed nodes), is rejected
+and retried with ``dt/4``.  Below ``dt_min`` the run stops with a FilmRuptureError that
+tells apart a film that closes (it decreased at that place over each of the last
+accepted steps, at a rate reaching zero within CLOSE_STEPS = 3 steps, or it is already
+below THIN_FILM = 1e-4 times the initial thinnest film: solid contact) from a step
+floor reached while the film was not closing.  An error estimate that stays above ``tol``
+at ``dt_min`` stops the run the same way (a :class:`~femehl.errors.SolverError` when the
+film is not closing).
+
+Every yielded State's ``info`` gets ``dt`` (the step that led to it, 0 for the first),
+``error_estimate`` (nan where none was made) and ``rejected`` (trial steps discarded since
+the previous yielded state).  Rejections are logged (logger ``"femehl"``, DEBUG), a summary
+at the end (INFO).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
+from femehl.solver.stepping import State, film_floor, film_positive
+from femehl.validation import check_positive
+
+__all__ = ["StepController", "march_adaptive", "breakpoints_of", "CONTROLS"]
+
+logger = logging.getLogger("femehl")
+
+#: a rejected (failed) trial is retried with this fraction of its step
+RETRY_FACTOR = 0.25
+#: "a few steps": a film closes when its last decrease extrapolates to zero within this many steps
+CLOSE_STEPS = 3.0
+#: ... or when, decreasing steadily, it is thinner than THIN_FILM times the initial thinnest film
+THIN_FILM = 1e-4
+#: the load component is relative to max(largest |load| so far, LOAD_FLOOR): loads are O(0.1 .. 1)
+#: in the paper's normalization, and a load growing from 0 has no relative error at t = 0
+LOAD_FLOOR = 0.1
+#: the local error is per unit time for steps longer than UNIT_STEP, per UNIT_STEP below
+UNIT_STEP = 0.01
+#: keyword arguments of :func:`march_adaptive` that tune the controller
+CONTROLS = ("dt0", "dt_min", "dt_max", "safety")
+
+
+@dataclass(frozen=True)
+class StepController:
+    """The step-size rule: ``dt * min(fac_max, max(fac_min, safety * (tol/err)^(1/p)))``.
+
+    ``err`` is an error per unit time of a method of order ``p`` (``err ~ dt^p``).
+    """
+
+    tol: float
+    safety: float = 0.9
+    fac_min: float = 0.2
+    fac_max: float = 2.0
+    hold: float = 1.5
+
+    def accepts(self, err: float) -> bool:
+        return err <= self.tol
+
+    def factor(self, err: float, order: int, grow: bool = True, dt: float = math.inf) -> float:
+        """The factor of the next step after an error ``err`` of a method of order ``order``."""
+        top = self.fac_max if grow else 1.0
+        if not err > 0.0:
+            return top
+        p = order if dt >= UNIT_STEP else order + 1
+        f = self.safety * (self.tol / err) ** (1.0 / p)
+        return min(top, max(self.fac_min, f))
+
+
+@dataclass
+class _Run:
+    """The explicit state of an adaptive run between trial steps."""
+
+    dt: float  # the next trial step
+    levels: list  # accepted states since the last (re)start, <= 3
+    pending: State | None = None  # the Euler start step, yielded once its pair passes
+    pending_rejected: int = 0
+    rejected: int = 0  # trials discarded since the last yielded state
+    grow: bool = True  # False right after a rejection
+    streak: int = 0  # consecutive error rejections of this step
+    load_scale: float = 0.0  # largest |load| so far
+    recent: deque = field(default_factory=lambda: deque(maxlen=6))  # last yielded states
+    film0: float = math.nan  # the initial thinnest film
+    accepted_total: int = 0
+    rejected_total: int = 0
+    dt_low: float = math.inf
+    dt_high: float = 0.0
+    #: the substrate's pressure follows the motion at once (``substrate.instant``: rigid):
+    #: the load jumps at the (re)start ``origin`` where hc' does, which is no time error
+    instant: bool = False
+    origin: float = -math.inf
+
+
+@dataclass(frozen=True)
+class _Failure:
+    """Why a trial step failed: the message, and the film and its place when known."""
+
+    reason: str
+    where: tuple | None = None
+    d: float | None = None
+    label: str = "the film points"
+
+
+# ---- helpers ------------------------------------------------------------------------------
+def breakpoints_of(scene) -> tuple:
+    """The motion's breakpoints (:attr:`femehl.problem.scene.Motion.breakpoints`), () if it has none."""
+    motion = getattr(scene, "motion", None)
+    return tuple(getattr(motion, "breakpoints", ()) or ())
+
+
+def _order(stepper) -> int:
+    return int(getattr(getattr(stepper, "scheme", None), "order", 2))
+
+
+def _tag(state: State, dt: float, err: float, rejected: int) -> State:
+    info = dict(state.info)
+    info.update(dt=float(dt), error_estimate=float(err), rejected=int(rejected))
+    return dataclasses.replace(state, info=info)
+
+
+def _restart(state: State) -> State:
+    """``state`` without its history: the next step is a backward-Euler (start) step."""
+    return dataclasses.replace(state, d_prev=None, dt_prev=None)
+
+
+def _lagrange(ts, t) -> np.ndarray:
+    """Weights of the polynomial through the times ``ts`` evaluated at ``t``."""
+    w = np.ones(len(ts))
+    for i, ti in enumerate(ts):
+        for j, tj in enumerate(ts):
+            if j != i:
+                w[i] *= (t - tj) / (ti - tj)
+    return w
+
+
+def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) -> float:
+    """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (see the module doc);
+    the film alone when ``load_pred`` is None."""
+    d = np.asarray(trial.d, dtype=float)
+    err = float(np.max(np.abs(d - d_pred) / d)) if d.size else 0.0
+    if load_pred is None:
+        return err
+    load = _load(trial)
+    scale = max(run.load_scale, abs(load), LOAD_FLOOR)
+    return max(err, abs(load - load_pred) / scale)
+
+
+def _load(state: State) -> float:
+    """The load of the step's own solution (half-Sommerfeld: before its clipping, so the
+    steps are those of the full-Sommerfeld run)."""
+    return float((state.info or {}).get("load_full", state.load))
+
+
+def _predict(run: _Run, levels, t):
+    """The film and load extrapolated to ``t``; the load of an instant substrate from the
+    levels after its (re)start only (linear from two, None from fewer)."""
+    w = _lagrange([s.t for s in levels], t)
+    d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels, strict=True))
+    if run.instant:
+        levels = [s for s in levels if s.t > run.origin]
+        if len(levels) < 2:
+            return d_pred, None
+        w = _lagrange([s.t for s in levels], t)
+    load_pred = float(sum(wi * _load(s) for wi, s in zip(w, levels, strict=True)))
+    return d_pred, load_pred
+
+
+def _milne(run: _Run, trial: State, order: int) -> float:
+    """The local error of a step of a method of ``order`` from its last ``order + 1`` levels."""
+    levels = run.levels[-(order + 1) :]
+    h = trial.t - levels[-1].t
+    h1 = levels[-1].t - levels[-2].t
+    if order == 1:
+        c = h / (2.0 * h + h1)
+    else:
+        h2 = levels[-2].t - levels[-3].t
+        om = h / h1
+        hb = h * (1.0 + om) / (1.0 + 2.0 * om)
+        c = hb / (hb + h + h1 + h2)
+    return c * _norm(run, trial, *_predict(run, levels, trial.t)) / max(h, UNIT_STEP)
+
+
+def _start_error(run: _Run, trial: State) -> float:
+    """The error of the Euler start step from the second difference of ``d0, d1, d2``."""
+    s0, s1 = run.levels[0], run.levels[1]
+    h1, h2 = s1.t - s0.t, trial.t - s1.t
+    err = _norm(run, trial, *_predict(run, [s0, s1], trial.t))
+    return h1 * h1 / (h2 * (h1 + h2)) * err / max(h1, UNIT_STEP)
+
+
+def _next_h(dt: float, remaining: float) -> float:
+    """The step toward a stop ``remaining`` ahead: land on it, never leave a sliver."""
+    if remaining <= dt * (1.0 + 1e-9):
+        return remaining
+    if remaining < 2.0 * dt:
+        return 0.5 * remaining
+    return dt
+
+
+def _try(stepper, base: State, t_new: float, h: float):
+    """One trial step: ``(state, None)`` or ``(None, _Failure)``."""
+    try:
+        s = stepper.step(base, t_new, h)
+    except FilmRuptureError as exc:
+        return None, _Failure(str(exc), tuple(exc.where), exc.d_min)
+    except SingularSystemError as exc:
+        return None, _Failure(f"singular step ({exc})")
+    if not film_positive(s):
+        d, at, label = film_floor(s)
+        return None, _Failure(f"film {d:.3g} <= 0", at, d, label)
+    return s, None
+
+
+def _film_track(stepper, states, where):
+    """Times and films at the film point nearest ``where`` (the film floor if it cannot tell)."""
+    pts = getattr(getattr(stepper, "disc", None), "film_points", None)
+    ts = [s.t for s in states]
+    if where is not None and pts is not None and all(np.size(s.d) == len(pts) for s in states):
+        i = int(np.argmin(np.sum((np.asarray(pts) - np.asarray(where)) ** 2, axis=1)))
+        return ts, [float(s.d[i]) for s in states]
+    return ts, [film_floor(s)[0] for s in states]
+
+
+def _closing(ts, ds, film0: float) -> float | None:
+    """The time the film reaches 0 if it closes steadily, else None.
+
+    Steadily: it decreased over each of the last (at least 3) accepted levels, and its last
+    rate of decrease reaches zero within CLOSE_STEPS steps, or it is already thinner than
+    THIN_FILM times the initial thinnest film ``film0``.
+    """
+    ts, ds = ts[-4:], ds[-4:]
+    if len(ds) < 3 or not all(b < a for a, b in zip(ds, ds[1:], strict=False)):
+        return None
+    h = ts[-1] - ts[-2]
+    rate = (ds[-2] - ds[-1]) / h
+    if rate <= 0.0:
+        return None
+    if ds[-1] / rate > CLOSE_STEPS * h and not ds[-1] < THIN_FILM * film0:
+        return None
+    return ts[-1] + ds[-1] / rate
+
+
+def _floor_error(
+    stepper, run: _Run, t_new: float, h: float, dt_min: float, fail: _Failure | None, err: float | None = None
+):
+    """The error to raise when a retry would go below ``dt_min``."""
+    last = run.levels[-1]
+    if fail is not None and fail.where is not None:
+        where, d, label = fail.where, fail.d, fail.label
+    else:
+        d, where, label = film_floor(last)
+    x, y = (tuple(where) + (0.0, 0.0))[:2]
+    states = list(run.recent)
+    ts, ds = _film_track(stepper, states, where)
+    t_zero = _closing(ts, ds, run.film0)
+    what = f"a trial step of dt = {h:.3g} to t = {t_new:.6g} " + (
+        f"failed ({fail.reason})" if fail is not None else f"has an error estimate {err:.3g} > tol"
+    )
+    history = ", ".join(f"{v:.3g}" for v in ds[-4:])
+    ts = ts[-4:]
+    if t_zero is not None:
+        exc = FilmRuptureError(
+            f"the film closes (solid contact) near t = {t_new:.6g}, at {label} (x, y) = ({x:.3g}, "
+            f"{y:.3g}): over the last accepted steps (t = {ts[0]:.6g} .. {ts[-1]:.6g}) it fell "
+            f"steadily ({history}), which extrapolates to zero by t = {t_zero:.6g}, and {what} "
+            f"at the step floor dt_min = {dt_min:.3g}. The load squeezes the film out: the "
+            "lubricated model no longer applies.",
+            t=t_new,
+            where=(x, y),
+            d_min=float(d),
+        )
+        exc.reason = "closes"
+        exc.film0 = float(run.film0)
+        return exc
+    msg = (
+        f"adaptive step floor reached at t = {last.t:.6g}: {what}, and the next retry would "
+        f"be below dt_min = {dt_min:.3g}; the film at {label} (x, y) = ({x:.3g}, {y:.3g}) is "
+        f"{float(d):.3g} and was not closing steadily over the last accepted steps "
+        f"({history}). Try a finer discretization or a smaller dt_min."
+    )
+    if fail is None:
+        exc = SolverError(msg, t=last.t)
+    else:
+        exc = FilmRuptureError(msg, t=last.t, where=(x, y), d_min=float(d))
+    exc.reason = "step floor"
+    exc.where, exc.d_min, exc.film0 = (x, y), float(d), float(run.film0)  # for femehl.auto
+    return exc
+
+
+def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf):
+    dt_max = t_span / 10.0 if dt_max is None else check_positive("dt_max", dt_max)
+    dt_max = min(dt_max, limit)  # the substrate's model resolves no longer step (its memory)
+    # the floor stays 100 times below the first step (a long run at a small tol starts
+    # with steps ~0.05 tol, below 1e-6 of its span)
+    dt_min = min(1e-6 * t_span, 5e-4 * tol, dt_max) if dt_min is None else check_positive("dt_min", dt_min)
+    if dt0 is None:
+        dt0 = max(dt_min, min(dt_max, 0.05 * tol))
+    dt0 = check_positive("dt0", dt0)
+    if dt0 > dt_max == limit:  # a first step given beyond what the substrate resolves
+        dt0 = max(dt_min, dt_max)
+    if not dt_min <= dt0 <= dt_max:
+        raise SceneError(f"need dt_min <= dt0 <= dt_max, got {dt_min:g}, {dt0:g}, {dt_max:g}.")
+    return dt0, dt_min, dt_max
+
+
+# ---- the time loop ------------------------------------------------------------------------
+def march_adaptive(
+    stepper,
+    t_end: float,
+    *,
+    tol: float,
+    dt0: float | None = None,
+    dt_min: float | None = None,
+    dt_max: float | None = None,
+    start: State | None = None,
+    safety: float = 0.9,
+) -> Iterator[State]:
+    """Yield the initial state, then every accepted state up to ``t_end`` (adaptive steps).
+
+    Parameters
+    ----------
+    stepper : LaggedStepper or any object with ``initial_state()``, ``step(state, t, dt)``
+        (and optionally ``scheme`` and ``scene`` for the order and the breakpoints).
+    t_end : float
+        End time; the last step lands on it.
+    tol : float
+        Relative local error per unit time, in the norm of the module docstring (0 < tol < 1);
+        the global error of load and films is then about tol or below.
+    dt0 : float, optional
+        First step and the step after each breakpoint; default ``0.05 tol``.
+    dt_min, dt_max : float, optional
+        Step floor and ceiling; default ``min(1e-6 span, 5e-4 tol)`` (100 times below
+        the default first step) and ``0.1`` times the run's span.  The ceiling is at most
+        the substrate's ``step_limit`` (:func:`femehl.elastic.base.step_limit`: the
+        largest step a viscoelastic memory resolves).
+    start : State, optional
+        Continue from this state (its history is dropped: the run restarts there).
+    safety : float, default: 0.9
+        The controller's safety factor.
+    """
+    t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
+    tol = check_positive("tol", tol, "Give a relative error per unit time, e.g. 1e-3.")
+    if tol >= 1.0:
+        raise SceneError(f"tol = {tol:g} is a relative error per unit time: use tol < 1 (e.g. 1e-3).")
+    safety = check_positive("safety", safety)
+    if safety > 1.0:
+        raise SceneError(f"safety = {safety:g} must be in (0, 1] (0.9 is usual).")
+    state = stepper.initial_state() if start is None else start
+    if t_end <= state.t:
+        raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
+    from femehl.elastic.base import step_limit
+
+    scene = getattr(stepper, "scene", None)
+    limit = step_limit(getattr(scene, "substrate", None), scene, getattr(stepper, "disc", None), t_end)
+    dt0, dt_min, dt_max = _limits(t_end - state.t, tol, dt0, dt_min, dt_max, limit)
+    eps = 1e-12 * max(1.0, abs(t_end))
+    stops = sorted(
+        {b for b in breakpoints_of(getattr(stepper, "scene", None)) if state.t + eps < b < t_end - eps}
+        | {t_end}
+    )
+    ctl = StepController(tol, safety)
+    order = _order(stepper)
+
+    state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
+    run = _Run(
+        dt=dt0,
+        levels=[_restart(state)],
+        load_scale=abs(_load(state)),
+        film0=film_floor(state)[0],
+        instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
+        origin=state.t,
+    )
+    run.recent.append(state)
+    yield state
+    for stop in stops:
+        while stop - run.levels[-1].t > eps:
+            yield from _advance(stepper, run, ctl, order, stop, dt_min, dt_max)
+        if run.pending is not None:  # an Euler start step that reached the stop alone
+            yield from _emit(run, run.pending, run.pending_rejected, math.nan)
+        if stop < t_end:  # a breakpoint: the derivatives jump, restart
+            run.levels = [_restart(run.levels[-1])]
+            run.origin = run.levels[0].t
+            run.dt = min(run.dt, dt0)
+            logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
+    logger.info(
+        "femehl: adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
+        t_end,
+        run.accepted_total,
+        run.rejected_total,
+        run.dt_low,
+        run.dt_high,
+    )
+
+
+def _emit(run: _Run, state: State, rejected: int, err: float):
+    state = _tag(state, state.t - run.recent[-1].t, err, rejected)
+    run.recent.append(state)
+    run.accepted_total += 1
+    run.dt_low = min(run.dt_low, state.info["dt"])
+    run.dt_high = max(run.dt_high, state.info["dt"])
+    run.pending = None
+    yield state
+
+
+def _reject(run: _Run, n: int, new_dt: float, what: str, t: float, h: float):
+    run.rejected += n
+    run.rejected_total += n
+    run.grow = False
+    logger.debug("adaptive: t = %.6g, dt = %.3g rejected (%s); retry with dt = %.3g", t, h, what, new_dt)
+    run.dt = new_dt
+
+
+def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, dt_min: float, dt_max: float):
+    """One trial step toward ``stop``; yields the states it accepts (none, one or two)."""
+    base = run.levels[-1]
+    remaining = stop - base.t
+    start_step = len(run.levels) == 1
+    if start_step:  # the Euler start step leaves room for the second step of its pair
+        h = min(run.dt, remaining) if remaining <= 2.0 * dt_min else min(run.dt, dt_max, 0.5 * remaining)
+    else:
+        h = _next_h(min(run.dt, dt_max), remaining)
+    t_new = stop if h == remaining else base.t + h
+    trial, fail = _try(stepper, base, t_new, h)
+    if fail is not None:
+        if h <= dt_min * (1.0 + 1e-9):
+            raise _floor_error(stepper, run, t_new, h, dt_min, fail)
+        _reject(run, 1, max(RETRY_FACTOR * h, dt_min), fail.reason, t_new, h)
+        return
+    run.load_scale = max(run.load_scale, abs(_load(trial)))
+    if start_step:
+        run.levels.append(trial)
+        run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0
+        run.dt = h
+        return
+    if run.pending is not None:  # the second step judges the Euler start step
+        err, p = _start_error(run, trial), 1
+    else:
+        err, p = _milne(run, trial, order), order
+    if not ctl.accepts(err):
+        if h <= dt_min * (1.0 + 1e-9):
+            raise _floor_error(stepper, run, t_new, h, dt_min, None, err)
+        if run.pending is not None:  # reject the pair: back to the level before it
+            h1 = run.pending.t - run.levels[0].t
+            if h1 <= dt_min * (1.0 + 1e-9):
+                raise _floor_error(stepper, run, t_new, h1, dt_min, None, err)
+            run.levels = run.levels[:1]
+            run.rejected += run.pending_rejected + 1
+            run.pending = None
+            _reject(
+                run,
+                1,
+                max(h1 * ctl.factor(err, 1, grow=False, dt=h1), dt_min),
+                f"start pair error {err:.3g} > tol",
+                t_new,
+                h1,
+            )
+            run.rejected_total += 1
+        else:
+            run.streak += 1
+            f = ctl.factor(err, p, grow=False, dt=h)
+            if run.streak > 1:  # the estimate is not asymptotic here: cut hard
+                f = min(f, ctl.fac_min)
+            _reject(run, 1, max(h * f, dt_min), f"error {err:.3g} > tol", t_new, h)
+        return
+    if run.pending is not None:
+        yield from _emit(run, run.pending, run.pending_rejected, err)
+    yield from _emit(run, trial, run.rejected, err)
+    run.rejected = 0
+    run.levels = (run.levels + [trial])[-3:]
+    f = ctl.factor(err, p, grow=run.grow, dt=h)
+    if 1.0 <= f < ctl.hold:  # small growth is not worth a new operator
+        f = 1.0
+    run.dt = min(dt_max, max(dt_min, h * f))
+    run.grow = True
+    run.streak = 0
+
+
+# ---- drivers ------------------------------------------------------------------------------

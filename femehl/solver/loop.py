@@ -1,0 +1,133 @@
+"""The one driver loop: build a method's stepper (:func:`make_stepper`) and march it,
+feeding every State to a Result and to the handlers attached (:func:`run_loop`).
+
+Every way of running femehl (``femehl.solve`` in both modes, the automatic sequence,
+``run_to_folder``, the CLI, sweeps) goes through here; docs/design.md section 8.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable
+
+from femehl.errors import SceneError, SolverError
+from femehl.output.result import Result
+from femehl.problem.scene import SceneEffects
+from femehl.solver.stepping import State, march
+from femehl.solver.threads import one_blas_thread
+
+__all__ = ["make_stepper", "methods", "run_loop"]
+
+
+def _registry():
+    from femehl.discretize import METHODS, method_class
+
+    method_class("fe")  # imports the registered discretizations
+    return METHODS
+
+
+@one_blas_thread
+def make_stepper(scene, method: str | None = None, **options):
+    """Build the stepper of ``method`` for ``scene`` (operators are built here, once).
+
+    ``options`` are split between the discretization (its constructor's parameters, e.g.
+    FE ``mesh``, FD ``dr``, line ``n_elements``) and the one stepper
+    (:class:`femehl.solver.stepper.LaggedStepper`: ``scheme``, ``linear_solver``, ``terms``
+    and the linear solver's ``rtol``, ``refactor_after``, ``recycle``).
+    """
+    from femehl.solver.linsolve import LINEAR_SOLVERS
+    from femehl.solver.stepper import LaggedStepper
+
+    methods = _registry()
+    if not isinstance(scene, SceneEffects):
+        raise SceneError(
+            f"scene must be a femehl.Scene (or femehl.line.LineScene), got {type(scene).__name__}."
+        )
+    if method is None:
+        method = scene.default_method
+    if not isinstance(method, str) or method not in methods:
+        raise SceneError(f"unknown method {method!r}: choose one of {sorted(methods)}.")
+    cls = methods[method]
+    disc_keys = set(inspect.signature(cls).parameters) - {"scene"}
+    solver_keys = set()
+    for sol in LINEAR_SOLVERS.values():
+        solver_keys |= set(inspect.signature(sol).parameters)
+    step_keys = {"scheme", "linear_solver", "terms"} | solver_keys
+    unknown = set(options) - disc_keys - step_keys
+    if unknown:
+        raise SceneError(
+            f"method {method!r} does not take {sorted(unknown)}; it takes {sorted(disc_keys | step_keys)}."
+        )
+    disc = cls(scene, **{k: v for k, v in options.items() if k in disc_keys})
+    return LaggedStepper(disc, **{k: v for k, v in options.items() if k in step_keys})
+
+
+def methods() -> list[str]:
+    """Names of the registered methods."""
+    return sorted(_registry())
+
+
+def run_loop(
+    stepper,
+    t_end: float,
+    dt: float | None = None,
+    *,
+    tol: float | None = None,
+    start: State | None = None,
+    store_every: int = 1,
+    on_state: Callable[[State], None] | None = None,
+    **controls,
+) -> Result:
+    """The one driver loop: march ``stepper`` and feed every State to a Result and ``on_state``.
+
+    Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
+    here.  Fixed steps ``dt`` (:func:`femehl.solver.stepping.march`), or adaptive steps to
+    ``tol`` (:func:`femehl.solver.adaptive.march_adaptive`, ``dt`` the first step, ``controls``
+    its ``dt_min``, ``dt_max``, ``safety``).  ``start`` resumes from a State (its own
+    record is kept, ``on_state`` is not called for it).  If the run stops on a
+    :class:`~femehl.errors.SolverError` or is interrupted, the partial Result is attached
+    to the exception as ``.result`` and the exception propagates; everything fed to
+    ``on_state`` before stays valid.
+    """
+    if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
+        raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
+    if tol is None:
+        if controls:
+            raise SceneError(f"{sorted(controls)} tune adaptive steps: give tol= as well.")
+        states = march(stepper, t_end, 0.01 if dt is None else dt, start=start)
+    else:
+        from femehl.solver.adaptive import march_adaptive
+
+        if dt is not None:
+            controls.setdefault("dt0", dt)
+        states = march_adaptive(stepper, t_end, tol=tol, start=start, **controls)
+    result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
+    last = None
+    rejected, dts = 0, []
+    try:
+        for state in states:
+            keep = store_every > 0 and state.step % store_every == 0
+            result.record(state, store_fields=keep)
+            rejected += state.info.get("rejected", 0)
+            if state.info.get("dt", 0.0) > 0.0:
+                dts.append(state.info["dt"])
+            if on_state is not None and (start is None or last is not None):
+                on_state(state)
+            last = (state, keep)
+    except (SolverError, KeyboardInterrupt) as exc:
+        exc.result = result
+        raise
+    finally:
+        if last is not None and store_every > 0 and not last[1]:
+            result._stored.append(last[0])
+        result.info.update(getattr(stepper, "info", {}))  # counters as at the end of the run
+        result.info["steps"] = result.nsteps
+        if tol is not None:
+            result.info.update(
+                tol=tol,
+                rejected_steps=rejected,
+                dt_smallest=min(dts, default=math.nan),
+                dt_largest=max(dts, default=math.nan),
+            )
+    return result

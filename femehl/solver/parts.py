@@ -1,0 +1,145 @@
+"""What takes part in a step beside the terms: the motion's unknown hc, a substrate's memory,
+a cavitation condition.  The protocol and the step's order: docs/design.md section 8."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from femehl.errors import SingularSystemError
+
+__all__ = ["StepPart", "Solved", "GapControl", "ImposedGap", "ImposedLoad", "FreeIndenter", "gap_control"]
+
+
+class StepPart:
+    """A part of every step with variables of its own (``state.own``); every hook optional.
+
+    In the step's order: :meth:`initial` (its variables at t = 0), :meth:`lagged` (the
+    pressure the lagged coefficients use), :meth:`film` (a change of the step's film
+    ``d = h + offset + scale C p``: a memory), :meth:`rows` (rows held or unknowns added
+    to the step's system), :meth:`finish` (its variables after the step).
+    """
+
+    def initial(self, stepper, state):
+        return state
+
+    def lagged(self, state, free_index):
+        return None
+
+    def film(self, stepper, state, t_new: float, dt: float):
+        return None
+
+    def rows(self, stepper, system, rhs_list, state, ctx):
+        return system, rhs_list, None
+
+    def finish(self, stepper, solved: Solved, new):
+        return new
+
+
+@dataclass(frozen=True)
+class Solved:
+    """What a step solved, handed to each part's :meth:`StepPart.finish`."""
+
+    state: object  # the state the step started from
+    ctx: object  # the terms' StepContext
+    op: object  # the step's StepOperator, no row held
+    rhs: np.ndarray  # its right-hand side without the -G h part
+    p: np.ndarray  # the pressure unknowns
+    Cp: np.ndarray  # C p on the film points
+    unknowns: np.ndarray  # the parts' own unknowns, after the pressure
+    aux: object  # what the part's rows() returned as aux
+    film: object  # the step's film change (a memory's) or None
+    scale: float  # the factor op.G carries (the film's scale)
+
+
+# ---- the motion's unknown: hc ------------------------------------------------------------
+class GapControl(StepPart):
+    """How the step gets ``hc``: the right-hand sides it adds and how it closes the solve."""
+
+    def rhs(self, stepper, rhs, G, shape, t_new) -> list:
+        raise NotImplementedError
+
+    def close(self, stepper, solutions, state, t_new, dt, ctx):
+        """``(x, Cp, hc, own)`` from the solver's ``[(x, Cp), ...]``: the solution, C p, hc
+        and the control's own variables after the step."""
+        raise NotImplementedError
+
+
+class ImposedGap(GapControl):
+    """``hc(t)`` given: one right-hand side."""
+
+    def rhs(self, stepper, rhs, G, shape, t_new):
+        return [rhs - G @ (stepper.scene.motion.hc(t_new) + shape)]
+
+    def close(self, stepper, solutions, state, t_new, dt, ctx):
+        ((x, Cp),) = solutions
+        return x, Cp, stepper.scene.motion.hc(t_new), {}
+
+
+class ImposedLoad(GapControl):
+    """``F(t)`` given, ``hc`` one more unknown.  The right-hand side is affine in hc
+    (``h = hc + s``), so with ``A x1 = b(h = s)`` and ``A x2 = G 1`` the bordered system
+    ``A p + hc G 1 = b(s)``, ``g . p = F`` gives ``hc = (g . x1 - F) / (g . x2)`` and
+    ``p = x1 - hc x2``: one operator, two right-hand sides, one linear system."""
+
+    def rhs(self, stepper, rhs, G, shape, t_new):
+        return [rhs - G @ shape, G @ np.ones(shape.size)]
+
+    def close(self, stepper, solutions, state, t_new, dt, ctx):
+        (x1, cx1), (x2, cx2) = solutions
+        n = stepper.disc.n  # a part's own unknowns follow the pressure
+        g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
+        hc, own = self.hc(stepper, state, t_new, dt, ctx, g1, g2)
+        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
+        return x1 - hc * x2, Cp, hc, own
+
+    def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
+        """``(hc, own)``: the load row ``g . p = F``."""
+        if not np.isfinite(g2) or g2 == 0.0:
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g}: the load row is singular (the film does not respond to hc).",
+                t=t_new,
+            )
+        return (g1 - stepper.scene.motion.F(t_new)) / g2, {}
+
+
+class FreeIndenter(ImposedLoad):
+    """``m hc'' = load - force``: hc from Newton's row (own variables ``hc_dot``, and
+    ``hc_prev``, ``hc_dot_prev`` for BDF2)."""
+
+    def initial(self, stepper, state):
+        return state.with_own(hc_dot=stepper.scene.motion.hc_dot0)
+
+    def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
+        """``(hc, own)`` by the step's own scheme (BDF2 with its variable-step coefficients, or Euler) on hc
+        and v = hc'::
+
+            a0 hc' - (a1 hc - a2 hc_prev) = dt v',   m (a0 v' - (a1 v - a2 v_prev)) = dt f',
+
+        ``f' = g . p' - force(t')`` with ``g . p' = g1 - hc' g2`` linear in hc': one more
+        row, solved in closed form.  L-stable: a small mass tends to the imposed-load step
+        (``hc' = (g1 - force)/g2`` at m = 0)."""
+        mo = stepper.scene.motion
+        m, a0, a1, a2 = mo.mass, ctx.a0, ctx.a1, ctx.a2
+        own = state.own
+        v = own.get("hc_dot", mo.hc_dot0)
+        if a2 != 0.0 and "hc_prev" in own and "hc_dot_prev" in own:
+            h_hist, v_hist = a1 * state.hc - a2 * own["hc_prev"], a1 * v - a2 * own["hc_dot_prev"]
+        else:  # the first step (or after a restart without history): the one-step scheme
+            a0, h_hist, v_hist = 1.0, state.hc, v
+        den = m * a0 * a0 / dt + dt * g2
+        if not np.isfinite(den) or den == 0.0:
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g}: the free indenter's row is singular (m a0^2/dt + dt g.x2 = 0).",
+                t=t_new,
+            )
+        hc = (dt * (g1 - mo.applied_force(t_new)) + (m / dt) * (a0 * h_hist + dt * v_hist)) / den
+        return hc, {"hc_dot": (a0 * hc - h_hist) / dt, "hc_prev": state.hc, "hc_dot_prev": v}
+
+
+def gap_control(motion) -> GapControl:
+    """The motion's: a free indenter, an imposed load, or an imposed gap."""
+    if motion.free:
+        return FreeIndenter()
+    return ImposedLoad() if motion.solves_hc else ImposedGap()

@@ -1,0 +1,375 @@
+"""The one stepper: a scene's lagged Reynolds step, assembled from terms, for any method.
+
+Per step (the paper's section 3: every nonlinear coefficient lagged, so ONE linear system)
+
+    sum_terms [ matrix p + c_term F_term d^{k+1} ] = sum_terms rhs,    d^{k+1} = h^{k+1} + C p,
+
+that is ``A p = b`` with ``A = D + G C``, ``G = sum c_term F_term`` and
+``b = rhs - G h^{k+1}`` (see :mod:`femehl.solver.terms`).  The discretization supplies the
+operators, the substrate its compliance ``C`` (``w = -C p`` on the film points, see
+:mod:`femehl.elastic`), the linear solver (:mod:`femehl.solver.linsolve`) solves.
+
+Beside the terms, the step's parts (:mod:`femehl.solver.parts`): the motion's unknown hc
+(imposed gap, imposed load, free indenter), a substrate's memory, a cavitation condition.
+
+After the solve the film is known everywhere the discretization can tell: on its film
+points, at the origin (exact compliance row) and at the nodes where a cheap estimate of
+the nodal film is thinnest (exact compliance rows there).  ``State.film_min`` is the
+smallest of them (so the central film is never below it; ``info["film_points_min"]`` is
+the film points' own minimum), and a film <= 0 anywhere raises
+:class:`~femehl.errors.FilmRuptureError` from :func:`femehl.solver.stepping.march`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from femehl.errors import SceneError, SingularSystemError
+from femehl.solver.linsolve import StepOperator, film_rtol_scale, make_linear_solver
+from femehl.solver.parts import Solved, gap_control
+from femehl.solver.stepping import State, get_scheme
+from femehl.solver.terms import StepContext, terms_for
+
+__all__ = ["LaggedStepper"]
+
+_PROBE_FRACTION = 0.5  # nodes whose estimated film is below this x the film minimum are checked exactly
+_MAX_PROBES = 64
+_ALWAYS_PROBED = 8  # the nodes of smallest estimated film, checked exactly at every step
+_ROW_CACHE = 512  # compliance rows of probed nodes kept between steps
+
+
+def _nbytes(a) -> int:
+    if isinstance(a, np.ndarray) or getattr(a, "is_fast", False):
+        return int(a.nbytes)
+    if sp.issparse(a):
+        a = a.tocsr()
+        return a.data.nbytes + a.indices.nbytes + a.indptr.nbytes
+    return 0
+
+
+def _deflection(rows_p, mem, points) -> np.ndarray:
+    """``-w`` at ``points`` from the compliance rows times p (viscoelastic: scaled, plus the
+    material's history there)."""
+    u = np.asarray(rows_p, dtype=float).ravel()
+    return u if mem is None else mem.scale * u + mem.offset_at(points)
+
+
+class LaggedStepper:
+    """Advance a discretized scene by one lagged linear step.
+
+    Parameters
+    ----------
+    disc : Discretization
+        Built from the scene (see :mod:`femehl.discretize`).
+    scheme : {"euler", "bdf2"}, default: "euler"
+        "euler" is the paper's first-order scheme; "bdf2" is second order, still one
+        linear system per step (:data:`femehl.solver.stepping.SCHEMES`).
+    linear_solver : str, optional
+        A key of :data:`femehl.solver.linsolve.LINEAR_SOLVERS`; default: the
+        discretization's (``"gmres"`` for FE disks, ``"lu"`` for the FD reference and
+        line contact).
+    terms : sequence of Term, optional
+        Extra physics terms added to the registered ones.
+    **solver_options
+        Options of the linear solver (``rtol``, ``refactor_after``, ``recycle``).
+    """
+
+    def __init__(
+        self, disc, scheme: str = "euler", linear_solver: str | None = None, terms=(), **solver_options
+    ):
+        t0 = time.perf_counter()
+        scene = disc.scene
+        self.scene = scene
+        self.disc = disc
+        self.method = disc.method
+        self.scheme = get_scheme(scheme)
+        self.beta = scene.fluid.beta
+        self.terms = terms_for(scene, None, terms)
+        for term in self.terms:
+            term.setup(disc)
+        name = disc.default_linear_solver if linear_solver is None else linear_solver
+        if not isinstance(name, str):
+            raise SceneError(f"linear_solver must be a name such as 'gmres' or 'lu', got {name!r}.")
+        if name == "lu" and solver_options:
+            raise SceneError(f"linear_solver='lu' takes no options, got {sorted(solver_options)}.")
+        self.solver = make_linear_solver(name, **solver_options)
+        if name == "lu" and disc.info.get("operator") == "dense":  # a double-precision LU
+            from femehl.discretize.mesh import check_mesh_memory
+
+            check_mesh_memory(disc.info["elements"], disc.info["unknowns"], disc.info["mesh"], lu_itemsize=8)
+        substrate = scene.substrate
+        t1 = time.perf_counter()
+        self.C = substrate.compliance_operator(disc)
+        self.dense = isinstance(self.C, np.ndarray)
+        self.fast = bool(getattr(self.C, "is_fast", False))
+        if self.fast and name == "lu":
+            raise SceneError(
+                "linear_solver='lu' needs the dense elastic operator: use operator='dense' "
+                "(if the mesh fits) or linear_solver='gmres' with the fast operator."
+            )
+        t2 = time.perf_counter()
+        self.origin = np.zeros((1, 2))
+        self.centre_row = substrate.deflection_rows(disc, self.origin)
+        self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
+        self.shape = disc.shape
+        self.g = disc.load_weights
+        from femehl.solver.cavitation import cavitation_model
+
+        self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
+        if self.cavitation is not None:
+            self.cavitation.check_scene(scene)
+            self.cavitation.setup(disc)
+        memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
+        self.memory = None if memory is None else memory(disc)
+        #: what takes part in the step beside the terms (femehl.solver.parts): the motion's
+        #: unknown hc, then the substrate's memory and the fluid's cavitation condition
+        self.gap = gap_control(scene.motion)
+        self.parts = [part for part in (self.memory, self.cavitation) if part is not None]
+        from femehl.output.table import extra_columns
+        from femehl.solver.energetics import TRIBOLOGY_COLUMNS
+
+        # the energy budget's figures the scene reports (femehl.solver.energetics), where the method has them
+        self._tribology = [c for c in extra_columns(scene) if c in TRIBOLOGY_COLUMNS]
+        if not hasattr(disc, "pressure_gradient"):
+            self._tribology = []
+        self._FC: dict[str, object] = {}
+        self._rows_cache: dict[int, np.ndarray] = {}
+        self.info = dict(disc.info)
+        self.info.update(
+            {
+                "method": self.method,
+                "scheme": self.scheme.name,
+                "substrate": type(substrate).__name__,
+                "linear_solver": name,
+                "terms": [t.name for t in self.terms],
+                "elastic_build_s": t2 - t1,
+                **({"fast_operator": dict(self.C.info)} if self.fast else {}),
+                "operator_bytes": int(_nbytes(self.C)),
+                **{f"{t.name}_assembled": False for t in self.terms},
+                "factorizations": 0,
+                "krylov_iterations": 0,
+            }
+        )
+        if self.cavitation is not None:  # how the reported fields are to be read
+            self.info.update(cavitation=self.cavitation.name, cavitation_note=self.cavitation.note)
+        for term in self.terms:  # film products every step needs: formed here, once
+            if getattr(term, "every_step", False):
+                self._film_product(term)
+        self.info["setup_s"] = disc.info.get("setup_s", 0.0) + time.perf_counter() - t0
+
+    # ---- operators ----------------------------------------------------------------------
+    @property
+    def film_products(self) -> dict:
+        """The fixed products ``F C`` formed so far, by term name (dense or sparse)."""
+        return {name: FC for name, (_, FC) in self._FC.items()}
+
+    def _film_product(self, term):
+        """``(F, F C)`` of a term, asked of the term and formed once, the first time needed."""
+        pair = self._FC.get(term.name)
+        if pair is None:
+            F = term.film_operator()
+            if self.fast:  # never formed: the sparse near-field product, for the preconditioner
+                FC = sp.csr_matrix(F @ self.C.preconditioner)
+            else:
+                FC = np.asarray(F @ self.C) if self.dense else sp.csr_matrix(F @ self.C)
+            pair = self._FC[term.name] = (F, FC)
+            self.info["operator_bytes"] += _nbytes(FC)
+            self.info[f"{term.name}_assembled"] = True
+        return pair
+
+    def operator(self, ctx: StepContext, scale: float = 1.0):
+        """The step's :class:`StepOperator` and its right-hand side without the ``-G h`` part.
+
+        ``scale`` multiplies the compliance (``d = h + scale C p``; a viscoelastic step's
+        ``J_eff``): it scales the film coefficients, so ``op.G`` is ``scale`` times the
+        terms' ``G``."""
+        D = None
+        films = []
+        rhs = np.zeros(self.disc.n)
+        for term in self.terms:
+            c = term.contribute(ctx)
+            if c.matrix is not None:
+                D = c.matrix if D is None else D + c.matrix
+            if c.film_coefficient != 0.0:
+                films.append((c.film_coefficient * scale, *self._film_product(term)))
+            if c.rhs is not None:
+                rhs += c.rhs
+        if D is None:
+            D = sp.csr_matrix((self.disc.n, self.disc.n))
+        return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
+
+    # ---- states -------------------------------------------------------------------------
+    def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, mem=None) -> State:
+        disc = self.disc
+        if Cp is None:
+            Cp = np.asarray(self.C @ p).ravel()
+        defl = Cp if mem is None else mem.scale * Cp + mem.offset  # -w on the film points
+        w = -defl
+        d = hc + self.shape + defl
+        p_full = disc.expand(p)
+        i_min = int(np.argmin(d))
+        i_max = int(np.argmax(p_full))
+        info = dict(info or {})
+        info.update(self._probe(hc, p, defl, float(d[i_min]), mem))
+        film_center = hc + self.s0 + float(_deflection(self.centre_row @ p, mem, self.origin)[0])
+        # the reported minimum is the true minimum of the discrete film: film points, the
+        # origin and the probed nodes (the central film is never below it)
+        info["film_points_min"] = float(d[i_min])
+        lows = [
+            (float(d[i_min]), tuple(float(v) for v in disc.film_points[i_min])),
+            (film_center, (0.0, 0.0)),
+        ]
+        if "node_film_min" in info:
+            lows.append((info["node_film_min"], info["node_film_min_at"]))
+        film_min, film_min_at = min(lows, key=lambda c: c[0] if np.isfinite(c[0]) else -np.inf)
+        return State(
+            step=step,
+            t=t,
+            hc=hc,
+            V=V,
+            p=p_full,
+            w=w,
+            d=d,
+            load=float(self.g @ p),
+            film_center=film_center,
+            film_min=film_min,
+            film_min_at=film_min_at,
+            p_max=float(p_full[i_max]),
+            p_max_at=tuple(float(v) for v in disc.nodes[i_max]),
+            info=info,
+            d_prev=d_prev,
+            dt_prev=dt_prev,
+        )
+
+    def _probe(self, hc, p, defl, d_min, mem=None):
+        """The exact film at the nodes where a cheap nodal estimate says it is thinnest.
+
+        The estimate is ``hc + s(node) +`` the mean of ``C p`` over the elements around the
+        node; the ``_ALWAYS_PROBED`` smallest, and every node below ``_PROBE_FRACTION``
+        times the film-point minimum (at most ``_MAX_PROBES``), get the exact value from
+        the substrate's rows at the node (kept between steps: the thin nodes move slowly).
+        """
+        avg = self.disc.node_average
+        if avg is None:
+            return {}
+        est = hc + self.disc.node_shape + avg @ defl
+        k = min(_ALWAYS_PROBED, est.size)
+        near = np.argpartition(est, k - 1)[:k]
+        thin = np.flatnonzero(est < _PROBE_FRACTION * d_min)
+        thin = thin[np.argsort(est[thin])[:_MAX_PROBES]]
+        nodes = np.union1d(near, thin)
+        rows = self._node_rows(nodes)
+        exact = hc + self.disc.node_shape[nodes] + _deflection(rows @ p, mem, self.disc.nodes[nodes])
+        j = int(np.argmin(exact))
+        return {
+            "node_film_min": float(exact[j]),
+            "node_film_min_at": tuple(float(v) for v in self.disc.nodes[nodes[j]]),
+        }
+
+    def _node_rows(self, nodes):
+        """Dense compliance rows at the given node indices, from a bounded cache."""
+        cache = self._rows_cache
+        new = [i for i in nodes if i not in cache]
+        if new:
+            R = self.scene.substrate.deflection_rows(self.disc, self.disc.nodes[new])
+            R = R.toarray() if sp.issparse(R) else np.asarray(R)
+            for i, r in zip(new, R, strict=True):
+                cache[i] = r
+            while len(cache) > _ROW_CACHE:
+                cache.pop(next(iter(cache)))
+        return np.array([cache[i] for i in nodes])
+
+    def initial_state(self) -> State:
+        mo = self.scene.motion
+        state = self._state(0, 0.0, mo.hc(0.0), mo.V(0.0), np.zeros(self.disc.n))
+        for part in (self.gap, *self.parts):  # their own variables at rest
+            state = part.initial(self, state)
+        self._budget(state)
+        return state
+
+    def _budget(self, state):
+        """The energy budget's figures the scene reports (femehl.solver.energetics), into ``state.info``."""
+        if self._tribology:
+            from femehl.solver.energetics import sliding_energetics
+
+            e = sliding_energetics(self.disc, state, self.beta)
+            state.info.update({k: e[k] for k in self._tribology})
+
+    # ---- one step -----------------------------------------------------------------------
+    def step(self, state: State, t_new: float, dt: float) -> State:
+        """One lagged step: terms -> extra unknowns -> ONE linear solve -> state."""
+        ctx = self._context(state, t_new, dt)
+        film = self._film(state, t_new, dt)
+        scale = 1.0 if film is None else film.scale
+        op, rhs = self.operator(ctx, scale)
+        G = op.G if film is None else op.G / scale  # the terms' G (op.G carries the film's scale)
+        shape = self.shape if film is None else self.shape + film.offset
+        system, rhs_list = op, self.gap.rhs(self, rhs, G, shape, t_new)
+        auxes = []
+        for part in self.parts:  # rows held, or unknowns added
+            system, rhs_list, aux = part.rows(self, system, rhs_list, state, ctx)
+            auxes.append(aux)
+        its0 = self.solver.info.get("krylov_iterations", 0)
+        solutions = self.solver.solve(system, rhs_list, t_new)
+        x, Cp, hc, own = self.gap.close(self, solutions, state, t_new, dt, ctx)
+        if not (np.all(np.isfinite(x)) and np.isfinite(hc)):  # a part's unknowns too
+            raise SingularSystemError(
+                f"step at t = {t_new:.6g} produced non-finite pressure: the system is singular "
+                "or ill-conditioned. Try a smaller dt or a finer discretization.",
+                t=t_new,
+            )
+        n = self.disc.n
+        p = x[:n]
+        self.info.update(self.solver.info)
+        info = {"krylov_iterations": self.solver.info.get("krylov_iterations", 0) - its0}
+        if self.solver.residuals:
+            info["residual"] = max(self.solver.residuals)
+        if Cp is None:
+            Cp = np.asarray(self.C @ p).ravel()
+        new = self._state(state.step + 1, t_new, hc, ctx.V, p, Cp, state.d, dt, info, film)
+        self._budget(new)
+        if own:
+            new = new.with_own(**own)
+        for part, aux in zip(self.parts, auxes, strict=True):
+            solved = Solved(state, ctx, op, rhs, p, Cp, x[n:], aux, film, scale)
+            new = part.finish(self, solved, new)
+        return new
+
+    def _context(self, state: State, t_new: float, dt: float) -> StepContext:
+        """The terms' lagged context: the scheme's coefficients, the lagged film and pressure."""
+        omega = None if state.d_prev is None or not state.dt_prev else dt / state.dt_prev
+        a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
+        if l1 == 0.0:
+            d_lag, hist = state.d, state.d
+        else:  # extrapolated coefficient, kept positive
+            d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
+            hist = a1 * state.d - a2 * state.d_prev
+        free_index = self.disc.free_index
+        p_old = state.p[free_index]
+        for part in self.parts:
+            lagged = part.lagged(state, free_index)
+            p_old = p_old if lagged is None else lagged
+        self.solver.rtol_scale = film_rtol_scale(state.d, state.w)  # the residual follows the film
+        return StepContext(
+            t_new=t_new,
+            dt=dt,
+            a0=a0,
+            d=state.d,
+            d_lag=d_lag,
+            history=hist,
+            p=p_old,
+            V=self.scene.motion.V(t_new),
+            beta=self.beta,
+            a1=a1,
+            a2=a2,
+        )
+
+    def _film(self, state: State, t_new: float, dt: float):
+        """The step's change of the film (``d = h + offset + scale C p``), at most one part's."""
+        films = [f for f in (part.film(self, state, t_new, dt) for part in self.parts) if f is not None]
+        if len(films) > 1:
+            raise SceneError("two step parts change the film: femehl composes at most one.")
+        return films[0] if films else None

@@ -1,0 +1,190 @@
+"""The time loop as a generator of :class:`State`, shared by every solver.
+
+A *stepper* (:class:`femehl.solver.stepper.LaggedStepper`, the same for every
+method) builds its operators once and advances one step; this module only
+walks time.  The scheme is the paper's
+(section 3): every nonlinear coefficient is lagged one step, so each step is
+ONE linear solve.  ``march`` yields the initial state and then one state per
+step, so a caller can stop, store or plot whenever it likes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from femehl.errors import FilmRuptureError, SceneError
+
+__all__ = [
+    "State",
+    "Stepper",
+    "march",
+    "check_run",
+    "Scheme",
+    "SCHEMES",
+    "get_scheme",
+    "film_floor",
+    "film_positive",
+]
+
+
+@dataclass(frozen=True)
+class State:
+    """Everything known at one time level.
+
+    ``p`` lives on the solver's pressure unknowns (FD: grid nodes; FE: mesh
+    nodes), ``w`` and ``d`` on its film locations (FD: grid nodes; FE: element
+    centroids).  Scalars are whole-plane figures in normalized units.
+    """
+
+    step: int
+    t: float
+    hc: float
+    V: float
+    p: np.ndarray
+    w: np.ndarray
+    d: np.ndarray
+    load: float
+    film_center: float
+    film_min: float
+    film_min_at: tuple
+    p_max: float
+    p_max_at: tuple
+    info: dict = field(default_factory=dict)
+    d_prev: np.ndarray | None = None  # d one step earlier (two-step schemes)
+    dt_prev: float | None = None  # the step that led to this state
+    #: the step parts' own variables by name (:mod:`femehl.solver.parts`: a free indenter's
+    #: ``hc_dot``, a viscoelastic memory's ``creep``, a cavitation condition's ``p_aux`` and
+    #: ``gas``), numbers or arrays; checkpoints write them as they are
+    own: dict = field(default_factory=dict)
+
+    def with_own(self, **values) -> State:
+        """This state with ``values`` added to (or replacing some of) its own variables."""
+        return dataclasses.replace(self, own={**self.own, **values})
+
+
+class Stepper(Protocol):
+    """What :func:`march` needs from a discretization."""
+
+    def initial_state(self) -> State: ...
+
+    def step(self, state: State, t_new: float, dt: float) -> State: ...
+
+
+def check_run(t_end, dt):
+    """Validate a run's horizon and step; return them as floats and the step count."""
+    from femehl.validation import check_positive
+
+    t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
+    dt = check_positive("dt", dt, "Give a positive time step (the paper uses 0.01).")
+    if dt > t_end:
+        raise SceneError(f"dt = {dt:g} is larger than t_end = {t_end:g}: use dt <= t_end.")
+    ratio = t_end / dt
+    if not math.isfinite(ratio) or ratio > 10_000_000:
+        raise SceneError(f"t_end/dt = {ratio:.3g} steps is too many: increase dt or decrease t_end.")
+    n = int(math.ceil(ratio - 1e-9))
+    if n > 10_000_000:
+        raise SceneError(f"{n} steps is too many: increase dt or decrease t_end.")
+    return t_end, dt, n
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """A time discretization that keeps ONE linear system per step.
+
+    The film's time derivative is ``(a0 d^{k+1} - a1 d^k + a2 d^{k-1}) / dt`` and the
+    lagged coefficients use ``d* = l0 d^k - l1 d^{k-1}``, with coefficients depending on
+    the step ratio ``omega = dt / dt_prev`` (variable-step formulas).
+    """
+
+    name: str
+    order: int
+
+    def coefficients(self, omega: float | None):
+        """``(a0, a1, a2, l0, l1)`` for step ratio ``omega`` (None: first step)."""
+        if self.order == 1 or omega is None:
+            return 1.0, 1.0, 0.0, 1.0, 0.0
+        w = omega
+        return (1 + 2 * w) / (1 + w), 1 + w, w * w / (1 + w), 1 + w, w
+
+
+#: "euler": the paper's scheme (backward Euler in d_t, coefficients lagged one step);
+#: "bdf2": BDF2 in d_t with coefficients extrapolated linearly from two steps.
+SCHEMES = {"euler": Scheme("euler", 1), "bdf2": Scheme("bdf2", 2)}
+
+
+def get_scheme(name: str) -> Scheme:
+    if not isinstance(name, str) or name not in SCHEMES:
+        raise SceneError(f"unknown time scheme {name!r}: choose one of {sorted(SCHEMES)}.")
+    return SCHEMES[name]
+
+
+def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None) -> Iterator[State]:
+    """Yield the initial state, then one :class:`State` per step up to ``t_end``.
+
+    The last step is shortened so the run ends exactly at ``t_end``.  With ``start``
+    (a State of an earlier run, e.g. from a checkpoint) the run continues from it.  A film
+    thickness reaching zero raises :class:`~femehl.errors.FilmRuptureError`
+    from the step that produced it (everything yielded before stays valid).
+    """
+    t_end, dt, n = check_run(t_end, dt)
+    if start is None:
+        state = stepper.initial_state()
+        k0 = 0
+    else:
+        state = start
+        k0 = int(round(start.t / dt))
+        if abs(k0 * dt - start.t) > 1e-9 * max(1.0, start.t):
+            raise SceneError(
+                f"cannot resume at t = {start.t:g} with dt = {dt:g}: resume with the dt of the original run."
+            )
+    yield state
+    for k in range(k0 + 1, n + 1):
+        t_new = min(k * dt, t_end)
+        h = t_new - state.t
+        if h <= 1e-14:
+            break
+        state = stepper.step(state, t_new, h)
+        _check_film(state)
+        yield state
+
+
+def film_floor(state: State) -> tuple:
+    """``(d, (x, y), where)``: the thinnest (or a non-finite) film ``state`` knows of.
+
+    Candidates: the origin (the central film), the probed nodes and the film points; on a
+    tie the first named wins (``state.film_min`` is already the smallest of them all).
+    """
+    cands = [(state.film_center, (0.0, 0.0), "the origin")]
+    if "node_film_min" in state.info:
+        cands.append((state.info["node_film_min"], tuple(state.info["node_film_min_at"]), "a node"))
+    cands.append((state.film_min, tuple(state.film_min_at), "the film points"))
+    bad = [c for c in cands if not math.isfinite(c[0])]
+    return bad[0] if bad else min(cands, key=lambda c: c[0])
+
+
+def film_positive(state: State) -> bool:
+    """True when every film ``state`` knows of is finite and > 0 (the test of
+    :func:`_check_film`, without raising)."""
+    d = film_floor(state)[0]
+    return math.isfinite(d) and d > 0.0
+
+
+def _check_film(state: State):
+    if film_positive(state):
+        return
+    d, (x, y), where = film_floor(state)
+    raise FilmRuptureError(
+        f"film thickness reached {d:.3g} <= 0 at t = {state.t:.6g}, at {where} "
+        f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "
+        "step was too coarse to follow it. Try a smaller dt or a finer mesh; if the "
+        "load truly squeezes the film out, the lubricated model no longer applies.",
+        t=state.t,
+        where=(x, y),
+        d_min=d,
+    )

@@ -99,7 +99,7 @@ def main():
         "",
         "Sphere, incompressible half space, the paper's motion (indent to hc = -1 over t <= 1, "
         "slide at V = tanh(t - 1)), BDF2 at dt = 0.01; values at t_end. The cavitated set is "
-        "lagged one step (`femehl.solver.cavitation`). Half-Sommerfeld is the full-Sommerfeld run with "
+        "lagged one step (`femehl.problem.cavitation`). Half-Sommerfeld is the full-Sommerfeld run with "
         "its negative pressures clipped after each solve: the same films, its load the clipped "
         "field's, with the full-Sommerfeld load of the same solution beside it (load before "
         "clipping); its cavitated area is that of the clipped nodes. Full-film source: the "
@@ -107,10 +107,10 @@ def main():
         "it adds to the full-film balance (the liquid created where the film reforms plus the "
         "cavity's gas growth and outflow through the rim; here mostly the gas leaving through "
         "the rim, see "
-        "`femehl.solver.cavitation.ReynoldsCavitation`). Most negative pressure: the lowest stored over "
+        "`femehl.problem.cavitation.ReynoldsCavitation`). Most negative pressure: the lowest stored over "
         "every step, relative to the peak (full Sommerfeld: its sub-ambient lobe; Reynolds: the "
         "one-step transient of a node joining the set; half-Sommerfeld: 0). JFO "
-        "(`femehl.solver.cavitation.JFOCavitation`, mass-conserving): mass imbalance is the largest "
+        "(`femehl.problem.cavitation.JFOCavitation`, mass-conserving): mass imbalance is the largest "
         "over every step of the discrete liquid balance d(liquid volume)/dt + net outflow, "
         "relative to the size of its terms; lowest filling is the smallest film content theta "
         "of a cavitated node over every step.",

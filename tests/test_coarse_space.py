@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 from femehl.api import make_stepper, run_loop
-from femehl.discretize.coarse import coarse_prolongation, node_sizes
 from femehl.discretize.fe_disk import FEDisc
 from femehl.discretize.fitted import fitted_disk
+from femehl.elastic.coarse import coarse_prolongation, node_sizes
 from femehl.elastic.hmatrix import FastCompliance
 from femehl.problem.presets import paper_sphere
 from femehl.solver.linsolve import PermutedLU, TwoLevel, nested_dissection

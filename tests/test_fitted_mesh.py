@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 import femehl
+from femehl.discretize import fitted as F
 from femehl.discretize.fitted import contact_extent, fitted_disk, fitted_sizes, hertz_ellipse
 from femehl.discretize.mesh import areas, load_mesh
 from femehl.errors import MeshError, SceneError
-from femehl.discretize import fitted as F
 from femehl.problem.indenters import Ellipsoid, FlatPunch, Shape, Sphere
 from femehl.problem.scene import Domain, Motion, RampHold, Scene, TanhStart, Winkler
 

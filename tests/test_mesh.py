@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import skfem
 
+from femehl.discretize import mesh as fm
 from femehl.discretize.mesh import LADDER, DiskMesh, areas, centroids, graded_disk, ladder_path, load_mesh
 from femehl.errors import MeshError
-from femehl.discretize import mesh as fm
 
 NAMES = ["coarse", "medium", "fine", "xfine"]
 

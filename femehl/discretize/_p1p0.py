@@ -20,7 +20,7 @@ class GasTransport:
     """Row operators of a P1 nodal gas film ``v`` (volume per area) on the free nodes (JFO).
 
     In the film's mass balance the liquid content is ``c = d - v`` (``d`` the gap on the
-    elements, ``v`` the gas in it, :class:`femehl.solver.cavitation.JFOCavitation`).  The Couette
+    elements, ``v`` the gas in it, :class:`femehl.problem.cavitation.JFOCavitation`).  The Couette
     row of the content is written element by element as fluxes between the element's
     node pairs, ``F_ij = V (b_i c_j - b_j c_i)/nv - delta_ij (c_j - c_i)`` with
     ``b_i = int_e dphi_i/dx`` and the node values ``c_k`` of the content in that element

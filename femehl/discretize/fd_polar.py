@@ -119,7 +119,7 @@ class FDDisc:
                 f"it needs an indenter symmetric in y; {type(scene.indenter).__name__} is not. "
                 "Use method='fe' (it meshes the full disk for such shapes)."
             )
-        from femehl.solver.cavitation import cavitation_model
+        from femehl.problem.cavitation import cavitation_model
 
         cav = cavitation_model(getattr(scene, "cavitation", None))
         if cav is not None and cav.changes_step:

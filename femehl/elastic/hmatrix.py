@@ -663,7 +663,7 @@ SINGLE_FACTORS_TOL = 1e-6
 PRECOND_RADIUS = 4.0
 
 
-#: coarse space of the preconditioner (:mod:`femehl.discretize.coarse`): about one coarse node per
+#: coarse space of the preconditioner (:mod:`femehl.elastic.coarse`): about one coarse node per
 #: COARSE_RATIO free nodes, between COARSE_MIN and COARSE_MAX (``C P`` costs
 #: elements x COARSE_MAX x 4 bytes: 2.4 GB at 1,000,000 elements)
 COARSE_RATIO, COARSE_MIN, COARSE_MAX = 12, 100, 600
@@ -780,7 +780,7 @@ class FastCompliance:
         self.H.kept = None
         self._pre = sp.csr_matrix((vals, (rows, cols)), shape=(ne, ne)) @ P
         self.shape = (ne, P.shape[1])
-        #: ``(P, C P)`` of the preconditioner's coarse space (:mod:`femehl.discretize.coarse`; C P
+        #: ``(P, C P)`` of the preconditioner's coarse space (:mod:`femehl.elastic.coarse`; C P
         #: elements x coarse nodes, single precision: it serves the preconditioner only),
         #: None on meshes too small for one
         self.coarse = None
@@ -794,7 +794,7 @@ class FastCompliance:
 
     def _coarse_space(self, disc, m: int) -> tuple:
         """``(P, C P)`` of about ``m`` coarse nodes, ``C P`` by blocked products (set-up)."""
-        from femehl.discretize.coarse import coarse_prolongation
+        from femehl.elastic.coarse import coarse_prolongation
 
         Pc, verts = coarse_prolongation(disc.mesh, disc.areas, disc.free, m)
         # columns in space order (leaves of a bisection tree of the coarse vertices): a

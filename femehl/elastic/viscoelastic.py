@@ -72,11 +72,12 @@ import scipy.sparse as sp
 from femehl.elastic.base import Substrate, register_substrate, substrate_operators
 from femehl.elastic.halfspace import HalfSpace
 from femehl.errors import SceneError
-from femehl.solver.energetics import ENERGETICS_COLUMNS
-from femehl.solver.parts import StepPart
 from femehl.validation import check_positive
 
-__all__ = ["Viscoelastic", "CreepMemory", "StepMemory"]
+__all__ = ["Viscoelastic", "CreepMemory", "StepMemory", "ENERGETICS_COLUMNS"]
+
+#: the sliding energy budget a viscoelastic run reports (:mod:`femehl.solver.energetics`)
+ENERGETICS_COLUMNS = ("friction", "dissipation_film", "power_sliding")
 
 
 @register_substrate
@@ -257,7 +258,7 @@ def _phi(r):
     return -np.expm1(-r) - b, b
 
 
-class CreepMemory(StepPart):
+class CreepMemory:
     """Exponential integrator of ``tau_c Dq/Dt = (J_inf - J0) u - q`` along the characteristics.
 
     State.  The internal variable lives on a uniform grid aligned with the sliding
@@ -432,6 +433,12 @@ class CreepMemory(StepPart):
     def initial(self, stepper, state):
         """The material at rest, unloaded: ``state.own["creep"] = 0``."""
         return state.with_own(creep=np.zeros(self.size))
+
+    def lagged(self, state, free_index):
+        return None
+
+    def rows(self, stepper, system, rhs_list, state, ctx):
+        return system, rhs_list, None
 
     def film(self, stepper, state, t_new: float, dt: float) -> StepMemory:
         return self.step(state, t_new, dt, stepper.scene.motion.V)

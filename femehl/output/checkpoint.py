@@ -39,7 +39,7 @@ import zlib
 import numpy as np
 
 from femehl.errors import CheckpointError, SceneError
-from femehl.solver.cavitation import CAVITATION_COLUMNS
+from femehl.problem.cavitation import CAVITATION_COLUMNS
 from femehl.solver.stepping import State
 
 logger = logging.getLogger("femehl")

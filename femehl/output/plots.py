@@ -583,7 +583,7 @@ def line_figure(result):
     cav = cavitated_nodes(result.disc, result.final)
     if cav is not None:
         spans = cavitated_intervals(result.disc.x, cav)
-        from femehl.solver.cavitation import clips_pressure
+        from femehl.problem.cavitation import clips_pressure
 
         label = _cavitation_label(clips_pressure(result.scene))
         for k, (a, b) in enumerate(spans):

@@ -55,7 +55,7 @@ class Result:
 
     def __post_init__(self):
         from femehl.output.table import extra_columns
-        from femehl.solver.cavitation import cavitation_columns
+        from femehl.problem.cavitation import cavitation_columns
 
         self._cavitation_columns = cavitation_columns(self.scene)
         self._extra_columns = extra_columns(self.scene)
@@ -66,7 +66,7 @@ class Result:
     def cavitation_columns(self) -> tuple:
         """The per-step figures the scene's cavitation condition adds (``()``: full
         Sommerfeld): ``cavitated_area``, and ``full_film_source`` (Reynolds) or ``load_full``
-        (half-Sommerfeld), see :mod:`femehl.solver.cavitation`."""
+        (half-Sommerfeld), see :mod:`femehl.problem.cavitation`."""
         return self._cavitation_columns
 
     @property

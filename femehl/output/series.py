@@ -5,7 +5,7 @@ small .pvd index (atomically), so an interrupted run leaves a readable
 series.  Pressure is point data (with ``cavitated``, 1 where the pressure is held at 0
 or, half-Sommerfeld, was clipped, for a run with a cavitation condition; a half-Sommerfeld
 run's files carry the field data ``HalfSommerfeldClipped = 1`` and, as an XML comment, how
-to read them: :attr:`femehl.solver.cavitation.HalfSommerfeld.note`);
+to read them: :attr:`femehl.problem.cavitation.HalfSommerfeld.note`);
 film thickness ``d``, deflection ``w`` and
 rigid gap ``h = d + w`` are point data on the FD grid (its unknowns live on
 nodes) and cell data on FE meshes (they live on elements).  Coordinates are
@@ -69,7 +69,7 @@ class SeriesWriter:
         self._source = None
         if self.mirrored:
             self.points, self.cells, self._source = mirror_half(self.points, self.cells)
-        from femehl.solver.cavitation import cavitation_model
+        from femehl.problem.cavitation import cavitation_model
 
         self.cavitation = cavitation_model(getattr(getattr(disc, "scene", None), "cavitation", None))
         self.entries: list[tuple[float, str]] = []

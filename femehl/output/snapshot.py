@@ -142,7 +142,7 @@ def snapshot(disc, state) -> Snapshot:
         cells = full_cells
     L = float(np.max(np.hypot(points[:, 0], points[:, 1])))
     fmin, at = state.film_min, tuple(state.film_min_at)
-    from femehl.solver.cavitation import clips_pressure
+    from femehl.problem.cavitation import clips_pressure
 
     clipped = clips_pressure(getattr(disc, "scene", None))
     return _build(state.t, points, cells, p, d, on_points, half, L, fmin, at, cav, clipped)

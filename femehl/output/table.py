@@ -2,7 +2,7 @@
 
 The columns are :data:`COLUMNS`; a run with a cavitation condition adds the condition's
 (:func:`columns_for`: ``cavitated_area`` and, for the Reynolds condition, ``full_film_source``,
-for half-Sommerfeld ``load_full``; see :mod:`femehl.solver.cavitation`), read from ``state.info``.
+for half-Sommerfeld ``load_full``; see :mod:`femehl.problem.cavitation`), read from ``state.info``.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def extra_columns(scene) -> tuple:
     """The per-step figures beyond :data:`COLUMNS` a run of ``scene`` reports: its cavitation
     condition's, then its substrate's (``substrate.columns``, e.g. a viscoelastic solid's
     sliding energy budget, :mod:`femehl.solver.energetics`); read from ``state.info``."""
-    from femehl.solver.cavitation import cavitation_columns
+    from femehl.problem.cavitation import cavitation_columns
     from femehl.solver.energetics import FREE_COLUMNS
 
     if scene is None:

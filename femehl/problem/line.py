@@ -19,7 +19,7 @@ The cylinder slides toward +x; in its frame the substrate moves toward -x,
 so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
 gap, hc < 0 an indentation.  Without a cavitation condition (full Sommerfeld) p may
 go negative (at the exit), as in the 2-D solvers; ``cavitation="jfo"``, ``"reynolds"`` or
-``"half-sommerfeld"`` as there (:mod:`femehl.solver.cavitation`).  The paper checks its scheme on this
+``"half-sommerfeld"`` as there (:mod:`femehl.problem.cavitation`).  The paper checks its scheme on this
 problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
 steady sliding solution, which :mod:`femehl.reference.line_steady` computes by
 quadrature and shooting.
@@ -115,7 +115,7 @@ class LineScene(SceneEffects):
     viscosity : femehl.Barus or femehl.Roelands, optional
         Pressure-dependent viscosity (:mod:`femehl.problem.viscosity`); None: isoviscous.
     cavitation : {None, "jfo", "reynolds", "half-sommerfeld"}, optional
-        Cavitation condition (:mod:`femehl.solver.cavitation`); None: full Sommerfeld.
+        Cavitation condition (:mod:`femehl.problem.cavitation`); None: full Sommerfeld.
     viscoelastic : femehl.Viscoelastic, optional
         A viscoelastic foundation: the standard linear solid whose relaxed stiffness is
         ``k * G_inf`` and unrelaxed ``k * G0`` (its ``elastic`` is the Winkler(k) of this
@@ -141,8 +141,8 @@ class LineScene(SceneEffects):
     profile: Callable | None = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from femehl.problem.cavitation import check_cavitation
         from femehl.problem.viscosity import check_viscosity
-        from femehl.solver.cavitation import check_cavitation
 
         check_viscosity(self.viscosity)
         check_cavitation(self.cavitation)
@@ -196,7 +196,7 @@ class LineScene(SceneEffects):
                 "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
                 "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
             )
-        from femehl.solver.cavitation import check_cavitation_scene
+        from femehl.problem.cavitation import check_cavitation_scene
 
         check_cavitation_scene(self)
         a = self.contact_halfwidth()

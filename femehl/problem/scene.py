@@ -233,7 +233,7 @@ class Fluid:
     step in the Poiseuille flux.  ``cavitation``: None (full Sommerfeld, the paper's),
     ``"jfo"`` (mass-conserving: the film content carried through the cavity),
     ``"reynolds"`` (``p >= 0``) or ``"half-sommerfeld"`` (the full-Sommerfeld run with its
-    negative pressures clipped in what is reported), see :mod:`femehl.solver.cavitation`.
+    negative pressures clipped in what is reported), see :mod:`femehl.problem.cavitation`.
     """
 
     beta: float = 200.0
@@ -241,8 +241,8 @@ class Fluid:
     cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
 
     def __post_init__(self):
+        from femehl.problem.cavitation import check_cavitation
         from femehl.problem.viscosity import check_viscosity
-        from femehl.solver.cavitation import check_cavitation
 
         check_cavitation(self.cavitation)
 
@@ -466,7 +466,7 @@ class Scene(SceneEffects):
                 "(the paper case uses h0 = +0.1)."
             )
         self._check_domain_holds_contact()
-        from femehl.solver.cavitation import check_cavitation_scene
+        from femehl.problem.cavitation import check_cavitation_scene
 
         check_cavitation_scene(self)
 

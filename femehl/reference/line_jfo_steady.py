@@ -1,6 +1,6 @@
 """Exact steady sliding with mass-conserving (JFO) cavitation: line contact, any rigid gap.
 
-Independent of the FE solver of :mod:`femehl.problem.line` and of :mod:`femehl.solver.cavitation`:
+Independent of the FE solver of :mod:`femehl.problem.line` and of :mod:`femehl.problem.cavitation`:
 quadrature and shooting, as :mod:`femehl.reference.line_steady` (which it reproduces without
 cavitation on the cylinder).  It is the reference the transient ``cavitation="jfo"``
 solver is validated against, with the Reynolds (Swift-Stieber) solution of the same
@@ -46,7 +46,7 @@ and cavitated.  Write ``J = -V q`` (``q > 0``: the film thickness of the flux, t
 The Reynolds (Swift-Stieber) condition
 --------------------------------------
 ``p >= 0`` with the Reynolds equation where ``p > 0`` and its residual >= 0 where
-``p = 0`` (the complementarity :class:`femehl.solver.cavitation.ReynoldsCavitation`
+``p = 0`` (the complementarity :class:`femehl.problem.cavitation.ReynoldsCavitation`
 imposes; an obstacle problem).  Its solution is C^1, so ``p = p' = 0`` at EVERY free
 boundary, rupture and reformation alike, and each full region has its own flux:
 the flux jumps at reformation (mass is created, ``V (q_2 - q)`` per unit time,

@@ -46,12 +46,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from femehl.elastic.viscoelastic import ENERGETICS_COLUMNS  # the columns the substrate reports
 from femehl.errors import SceneError
 
 __all__ = ["ENERGETICS_COLUMNS", "FREE_COLUMNS", "TRIBOLOGY_COLUMNS", "sliding_energetics"]
 
 #: the per-step figures a run on a viscoelastic substrate reports (summary.csv)
-ENERGETICS_COLUMNS = ("friction", "dissipation_film", "power_sliding")
 #: ... and a run of a free indenter (its collision's energy budget)
 FREE_COLUMNS = ("dissipation_film", "elastic_energy")
 #: every figure :func:`sliding_energetics` computes

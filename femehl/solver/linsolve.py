@@ -35,7 +35,7 @@ Solvers are registered in :data:`LINEAR_SOLVERS` by name:
     METIS nested-dissection order) of ``D + G C_near``, ``C_near`` the exact near field
     within a few element sizes (:attr:`femehl.elastic.hmatrix.FastCompliance.preconditioner`),
     after a coarse Galerkin correction on a coarse P1 space that carries the smooth far
-    field the near field misses (:class:`TwoLevel`, :mod:`femehl.discretize.coarse`: paper case
+    field the near field misses (:class:`TwoLevel`, :mod:`femehl.elastic.coarse`: paper case
     on 27,640 elements, 6.0 -> 1.85 iterations per step);
     there is no direct fallback (a solve that does not converge raises).  ``rtol`` is
     the relative residual ``||b - A x|| / ||b||``: default 1e-8 with the dense operator
@@ -230,7 +230,7 @@ class SwitchedOperator:
     """A step whose unknown ``j`` is ``p_j``, or on the switched set ``S`` an auxiliary ``v_j``.
 
     The system of ``2n`` unknowns ``(p, v)`` (a mass-conserving cavitation step,
-    :class:`femehl.solver.cavitation.JFOCavitation`: ``v`` the gas film)::
+    :class:`femehl.problem.cavitation.JFOCavitation`: ``v`` the gas film)::
 
         [ A      -B P_S ] [p]   [b]
         [ E_S     E_F   ] [v] = [0]      (p_j = 0 on S, v_j = 0 off it)
@@ -493,7 +493,7 @@ class PermutedLU:
 class TwoLevel:
     """Near-field LU plus a coarse Galerkin correction: ``solve(r)`` approximates ``A^-1 r``.
 
-    With ``P`` (n x m) a coarse P1 space (:func:`femehl.discretize.coarse.coarse_prolongation`)
+    With ``P`` (n x m) a coarse P1 space (:func:`femehl.elastic.coarse.coarse_prolongation`)
     and ``AP = A P = D P + G (C P)`` (:meth:`StepOperator.coarse_system`: ``C P`` formed
     once at set-up, sparse work per refresh), the coarse solve comes first and the
     near-field LU ``N`` smooths what is left: ``y = (P^T A P)^-1 P^T r``,

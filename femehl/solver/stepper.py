@@ -116,7 +116,7 @@ class LaggedStepper:
         self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
         self.shape = disc.shape
         self.g = disc.load_weights
-        from femehl.solver.cavitation import cavitation_model
+        from femehl.problem.cavitation import cavitation_model
 
         self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
         if self.cavitation is not None:

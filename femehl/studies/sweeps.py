@@ -95,7 +95,7 @@ logger = logging.getLogger("femehl")
 #: the headline columns of the table (each case's summary at its stored times): the
 #: estimated relative errors ``err_<q>`` (total) and their space and time parts (an
 #: expert run, e.g. ``mesh = "fitted"`` with ``dt``, has the parts only), and the figures
-#: of a cavitation condition (:data:`femehl.solver.cavitation.CAVITATION_COLUMNS`) and of a
+#: of a cavitation condition (:data:`femehl.problem.cavitation.CAVITATION_COLUMNS`) and of a
 #: viscoelastic substrate (:data:`femehl.solver.energetics.ENERGETICS_COLUMNS`); NaN for a case
 #: without one, or without that figure
 RESULT_COLUMNS = (

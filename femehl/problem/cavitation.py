@@ -67,7 +67,6 @@ import dataclasses
 import numpy as np
 
 from femehl.errors import SceneError
-from femehl.solver.parts import StepPart
 
 __all__ = [
     "CAVITATION_MODELS",
@@ -92,9 +91,9 @@ def register_cavitation(cls):
     return cls
 
 
-class _Model(StepPart):
+class _Model:
     """What the registered models share (see the module docstring); a step part
-    (:mod:`femehl.solver.parts`): its own variables ``p_aux`` (and JFO's ``gas``)."""
+    (:class:`femehl.solver.parts.StepPart`): its own variables ``p_aux`` (and JFO's ``gas``)."""
 
     name = ""
     changes_step = True
@@ -126,6 +125,9 @@ class _Model(StepPart):
 
     def lagged(self, state, free_index):
         return self.lagged_pressure(state, free_index)
+
+    def film(self, stepper, state, t_new, dt):
+        return None
 
     def rows(self, stepper, system, rhs_list, state, ctx):
         return self.prepare(stepper, system, rhs_list, state, ctx)

@@ -74,7 +74,9 @@ def run(beta: float, alpha: float, level: float) -> dict:
     mesh = fitted_disk(sc, T_END, level)
     rec = {"beta": beta, "alpha": alpha, "level": level, "elements": int(mesh.mesh.t.shape[1])}
     try:
-        res = femehl.solve(sc, t_end=T_END, mesh=mesh, tol=TOL, scheme="bdf2", estimate=False, store_every=0)
+        res = femehl.solve(
+            sc, t_end=T_END, mesh=mesh, step_tol=TOL, scheme="bdf2", estimate=False, store_every=0
+        )
     except femehl.errors.SolverError as exc:
         rec.update(error=f"{type(exc).__name__}: {exc}", wall_s=time.perf_counter() - t0)
         return rec

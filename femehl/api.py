@@ -74,6 +74,7 @@ def solve(
     t_end: float = 5.0,
     dt: float | None = None,
     tol: float | None = None,
+    step_tol: float | None = None,
     store_every: int = 1,
     callback: Callable[[State], None] | None = None,
     estimate: bool = True,
@@ -91,10 +92,10 @@ def solve(
       (cells) bound what it may spend, ``on_run=`` sees every finished run (pilots too);
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
       discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
-      ``tol`` is given.  The result carries the space part of the error estimate from a
-      companion run twice as coarse with the same steps (FE ladder rungs and ``"fitted"``,
-      line contact; about 10-25 % more work; ``estimate=False`` skips it) and, with
-      ``tol``, the time part (:func:`femehl.accuracy.auto.expert_estimate`).
+      ``step_tol`` is given.  The result carries the space part of the error estimate
+      from a companion run twice as coarse with the same steps (FE ladder rungs and
+      ``"fitted"``, line contact; about 10-25 % more work; ``estimate=False`` skips it)
+      and, with ``step_tol``, the time part (:func:`femehl.accuracy.auto.expert_estimate`).
 
     Parameters
     ----------
@@ -107,13 +108,15 @@ def solve(
     t_end : float, default: 5.0
         End time (normalized).
     dt : float, optional
-        Fixed time step (expert mode; default 0.01, the paper's value); with ``tol``, the
-        first step.
+        Fixed time step (expert mode; default 0.01, the paper's value); with ``step_tol``,
+        the first step.
     tol : float, optional
-        Automatic mode: the relative accuracy (default 1e-2).  Expert mode: adaptive time
-        steps (:mod:`femehl.solver.adaptive`) to this relative local error per unit time;
-        the scheme is then BDF2 unless given.  ``dt_min``, ``dt_max`` and ``safety`` tune
-        the controller.
+        The accuracy target of the automatic mode: load, central and minimum film within
+        this relative error (default 1e-2).
+    step_tol : float, optional
+        Expert mode: adaptive time steps (:mod:`femehl.solver.adaptive`) to this relative
+        local error per unit time; the scheme is then BDF2 unless given.  ``dt_min``,
+        ``dt_max`` and ``safety`` tune the controller.
     store_every : int, default: 1
         Keep the fields of every ``store_every``-th step (and the last); 0 keeps none.
     callback : callable, optional
@@ -129,7 +132,9 @@ def solve(
     from femehl.solver.adaptive import CONTROLS
     from femehl.solver.stepping import check_run
 
-    if is_automatic(scene, method, dt, options):
+    automatic = is_automatic(scene, method, dt, options)
+    check_tolerances(automatic, tol, step_tol)
+    if automatic:
         from femehl.accuracy.auto import solve_to_tolerance
 
         return solve_to_tolerance(
@@ -143,20 +148,41 @@ def solve(
         )
     refuse_auto_only(options)
     controls = {k: options.pop(k) for k in CONTROLS if k in options}
-    if tol is None:
+    if step_tol is None:
         dt = 0.01 if dt is None else dt
         check_run(t_end, dt)
     else:
         options.setdefault("scheme", "bdf2")
     stepper = make_stepper(scene, method, **options)
-    result = run_loop(stepper, t_end, dt, tol=tol, store_every=store_every, on_state=callback, **controls)
+    result = run_loop(
+        stepper, t_end, dt, step_tol=step_tol, store_every=store_every, on_state=callback, **controls
+    )
     from femehl.accuracy.auto import companion_run, expert_estimate
 
     companion, ratio = (
-        companion_run(scene, stepper.method, options, t_end, dt, tol, controls) if estimate else (None, None)
+        companion_run(scene, stepper.method, options, t_end, dt, step_tol, controls)
+        if estimate
+        else (None, None)
     )
-    result.estimate = expert_estimate(result, companion, ratio, adaptive=tol is not None)
+    result.estimate = expert_estimate(result, companion, ratio, adaptive=step_tol is not None)
     return result
+
+
+def check_tolerances(automatic: bool, tol, step_tol) -> None:
+    """``tol`` is the automatic mode's accuracy target, ``step_tol`` the expert mode's step
+    controller: SceneError naming the fix when one is given to the other mode."""
+    if automatic and step_tol is not None:
+        raise SceneError(
+            "step_tol tunes the adaptive steps of an expert run (a mesh or dt given); the "
+            "automatic mode chooses its own steps to tol: leave step_tol out, or give the mesh."
+        )
+    if not automatic and tol is not None:
+        raise SceneError(
+            f"tol = {tol!r} is the automatic mode's accuracy target, and this run is an expert one "
+            "(a mesh, grid or dt given): for adaptive time steps on that discretization give "
+            "step_tol= (a local error per unit time, e.g. 1e-3); for the accuracy target leave "
+            "out dt and the discretization options."
+        )
 
 
 def solve_line(

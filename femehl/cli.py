@@ -62,8 +62,13 @@ def _parser():
     r.add_argument(
         "--tol",
         type=float,
-        help="relative accuracy of load and films (default 0.01: femehl chooses mesh and steps); "
-        "with --mesh/--dt: adaptive time steps to this local error per unit time",
+        help="relative accuracy of load and films (default 0.01: femehl chooses mesh and steps)",
+    )
+    r.add_argument(
+        "--step-tol",
+        type=float,
+        help="with --mesh / --n-elements (expert mode): adaptive time steps to this local error "
+        "per unit time (--dt is then the first step)",
     )
     r.add_argument(
         "--max-wall",
@@ -147,7 +152,7 @@ def _parser():
 
 
 FD_KEYS = ("dr", "dtheta")
-RUN_KEYS = ("dt", "t_end", "store_every", "checkpoint_every", "tol")
+RUN_KEYS = ("dt", "t_end", "store_every", "checkpoint_every", "tol", "step_tol")
 
 
 def _method_options(run: dict, method: str, from_cli: bool) -> dict:
@@ -209,7 +214,18 @@ def _run(args, argv=()):
         )
     check_method_flags(method, {k: getattr(args, k) for k in METHOD_FLAGS})
     run = _method_options(run, method, from_cli=args.method is not None)
-    for key in ("scheme", "mesh", "operator", "n_elements", "dt", "tol", "max_wall", "t_end", "store_every"):
+    for key in (
+        "scheme",
+        "mesh",
+        "operator",
+        "n_elements",
+        "dt",
+        "tol",
+        "step_tol",
+        "max_wall",
+        "t_end",
+        "store_every",
+    ):
         v = getattr(args, key)
         if v is not None and not (key == "scheme" and method == "fd"):  # fd: euler, its own scheme
             run[key] = v

@@ -271,7 +271,7 @@ def test_line_contact_against_fine_fixed_step(line_reference, tol):
     tol 1e-3: 215 steps, 1 rejected, load 2.9e-4, film_min 2.9e-4
     (fixed dt = 0.01, 200 steps: load 9.3e-4, film_min 2.8e-5).
     """
-    res = solve(LineScene(), t_end=2.0, tol=tol, n_elements=400, store_every=0)
+    res = solve(LineScene(), t_end=2.0, step_tol=tol, n_elements=400, store_every=0)
     assert res.t[-1] == 2.0 and 1.0 in res.t
     load, fmin = _errors(res, line_reference)
     assert load < tol and fmin < tol, (load, fmin)
@@ -289,7 +289,7 @@ def test_paper_sphere_coarse_against_fine_fixed_step(fe_reference, tol):
     is ~tol, not below: tol bounds the error per unit time, and film_min follows the
     thinnest element, whose film has sharp (under-resolved) turns on the coarse mesh.
     """
-    res = solve(femehl.presets.paper_sphere(), "fe", t_end=2.0, tol=tol, mesh="coarse", store_every=0)
+    res = solve(femehl.presets.paper_sphere(), "fe", t_end=2.0, step_tol=tol, mesh="coarse", store_every=0)
     assert res.t[-1] == 2.0 and 1.0 in res.t
     load, fmin = _errors(res, fe_reference)
     assert load < tol and fmin < 1.5 * tol, (load, fmin)
@@ -297,7 +297,7 @@ def test_paper_sphere_coarse_against_fine_fixed_step(fe_reference, tol):
 
 def test_store_every_and_callback():
     seen = []
-    res = solve(LineScene(), t_end=1.0, tol=1e-2, n_elements=400, store_every=5, callback=seen.append)
+    res = solve(LineScene(), t_end=1.0, step_tol=1e-2, n_elements=400, store_every=5, callback=seen.append)
     assert len(seen) == res.nsteps + 1
     assert res.stored_times[-1] == 1.0
     assert all(s.step % 5 == 0 for s in res.states[:-1])

@@ -64,7 +64,7 @@ def test_a_fixed_step_run_has_no_estimate():
 
 
 def test_an_expert_adaptive_run_has_space_and_time_parts():
-    res = femehl.solve(LineScene(), t_end=1.0, tol=1e-2, n_elements=200, store_every=0)
+    res = femehl.solve(LineScene(), t_end=1.0, step_tol=1e-2, n_elements=200, store_every=0)
     u = res.uncertainty("film_min", 1.0)
     assert u["total"] == pytest.approx(u["space"] + u["time"])
     assert 0.0 < u["time"] < 1e-2 and 0.0 < u["space"] < 1e-2
@@ -122,7 +122,7 @@ def test_automatic_is_the_default():
 # ---- honesty --------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def line_reference():
-    return femehl.solve(LineScene(), t_end=2.0, tol=1e-5, n_elements=3200, store_every=0)
+    return femehl.solve(LineScene(), t_end=2.0, step_tol=1e-5, n_elements=3200, store_every=0)
 
 
 @pytest.mark.parametrize("tol", [1e-2, 1e-3])

@@ -217,7 +217,7 @@ def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
     x0 = x[k] - p[k] * (x[k + 1] - x[k]) / (p[k + 1] - p[k])
     assert half.final.info["cavitated_area"] == pytest.approx(x0 + L, abs=2 * np.diff(x).max())
     sc = LineScene(k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L)
-    opts = dict(t_end=1.0, tol=1e-3, n_elements=100, estimate=False, linear_solver="lu")
+    opts = dict(t_end=1.0, step_tol=1e-3, n_elements=100, estimate=False, linear_solver="lu")
     a = femehl.solve(sc, **opts)
     b = femehl.solve(dataclasses.replace(sc, cavitation="half-sommerfeld"), **opts)
     assert np.array_equal(a.t, b.t)

@@ -18,7 +18,7 @@ def _times(folder):
 
 def test_cli_tol_runs_adaptive_steps_and_resumes(tmp_path):
     out = tmp_path / "run"
-    args = ["run", "--mesh", "coarse", "--tol", "0.02", "--quiet", "--out", str(out)]
+    args = ["run", "--mesh", "coarse", "--step-tol", "0.02", "--quiet", "--out", str(out)]
     assert main([*args, "--t-end", "1.2"]) == 0
     t = _times(out)
     steps = np.diff(t)

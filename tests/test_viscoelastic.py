@@ -246,5 +246,5 @@ def test_adaptive_steps_reach_the_breakpoint():
     size.  Before the film points kept their defect this run stopped at the step floor
     (dt = 1.2e-6, error estimate 3.3e-3) on the fitted mesh; the coarse mesh shows it too."""
     sc = dataclasses.replace(paper_sphere(), substrate=femehl.Viscoelastic(G0=1.0, G_inf=2 / 3, tau=0.3))
-    r = femehl.solve(sc, t_end=1.2, mesh="coarse", tol=3e-3, estimate=False)
+    r = femehl.solve(sc, t_end=1.2, mesh="coarse", step_tol=3e-3, estimate=False)
     assert r.t[-1] == pytest.approx(1.2) and np.min(r.dt[1:]) > 1e-5

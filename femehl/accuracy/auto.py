@@ -317,10 +317,10 @@ def time_error(res: Result) -> np.ndarray:
     return np.cumsum(local)
 
 
-def companion_run(scene, method, options, t_end, dt, tol, controls) -> tuple:
+def companion_run(scene, method, options, t_end, dt, step_tol, controls) -> tuple:
     """``(Result, ratio)`` of the coarser companion of an expert run, or ``(None, None)``.
 
-    Same time steps as the run (fixed ``dt``, or adaptive to the same ``tol``), the
+    Same time steps as the run (fixed ``dt``, or adaptive to the same ``step_tol``), the
     method's :attr:`Ladder.companion` discretization.  A companion that stops (its
     coarser mesh may not resolve the film) is logged and gives no space estimate.
     """
@@ -333,7 +333,7 @@ def companion_run(scene, method, options, t_end, dt, tol, controls) -> tuple:
     coarse_options, ratio = plan
     try:
         coarse = make_stepper(scene, method, **coarse_options)
-        return run_loop(coarse, t_end, dt, tol=tol, store_every=0, **controls), ratio
+        return run_loop(coarse, t_end, dt, step_tol=step_tol, store_every=0, **controls), ratio
     except SolverError as exc:
         logger.warning("femehl: no space estimate: the coarser companion run stopped (%s)", exc)
         return None, None
@@ -459,7 +459,7 @@ def _run(
             on_state = _deadline_guard(deadline, on_state)
         try:
             res = run_loop(
-                stepper, t_end, None, tol=tol_t, store_every=store_every, on_state=on_state, **controls
+                stepper, t_end, None, step_tol=tol_t, store_every=store_every, on_state=on_state, **controls
             )
         finally:
             if bar is not None:

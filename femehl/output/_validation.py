@@ -51,15 +51,15 @@ def check_resume_overwrite(resume, overwrite) -> tuple[bool, bool]:
     return resume, overwrite
 
 
-def check_tol(tol):
-    """``tol`` as a float in (0, 0.5), or None (fixed time steps)."""
+def check_tol(tol, name: str = "tol"):
+    """``tol`` (or ``step_tol``) as a float in (0, 0.5), or None."""
     if tol is None:
         return None
     from femehl.validation import check_positive
 
-    tol = check_positive("tol", tol, "Give the relative error per unit time, e.g. tol = 1e-2.")
+    tol = check_positive(name, tol, f"Give a relative error, e.g. {name} = 1e-2.")
     if tol >= 0.5:
-        raise SceneError(f"tol = {tol:g} is not a relative error: give 0 < tol < 0.5, e.g. 1e-2.")
+        raise SceneError(f"{name} = {tol:g} is not a relative error: give 0 < {name} < 0.5, e.g. 1e-2.")
     return tol
 
 

@@ -24,12 +24,12 @@ import time
 
 import numpy as np
 
-from femehl.api import make_stepper, run_loop
 from femehl.errors import OutputError, SceneError, SolverError
 from femehl.output import RunWriter, checkpoint, draw_figures
 from femehl.output._validation import check_flag, check_resume_overwrite, check_run_options, check_tol
 from femehl.output.folder import check_folder, prepare_folder
 from femehl.output.result import Result
+from femehl.solver.loop import make_stepper, run_loop
 from femehl.solver.threads import one_blas_thread
 
 __all__ = ["run_to_folder"]
@@ -116,6 +116,7 @@ def run_to_folder(
     resume=False,
     overwrite=False,
     tol=None,
+    step_tol=None,
     **options,
 ) -> Result:
     """Solve ``scene`` and write ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs.
@@ -127,7 +128,7 @@ def run_to_folder(
     method : str, default: "fe"
     t_end : float, default: 5.0
     dt : float, optional
-        Fixed time step (expert mode, default 0.01); with ``tol`` the first step.
+        Fixed time step (expert mode, default 0.01); with ``step_tol`` the first step.
     store_every : int, default: 10
         Fields are kept and written every ``store_every`` steps (and at the end).
     progress : bool, default: False
@@ -151,7 +152,9 @@ def run_to_folder(
         stay in memory, each run that may be the answer is written here as it goes (a
         finer one replaces it), and at the end ``summary.csv`` gets the error estimate
         columns (:data:`femehl.output.table.ERROR_COLUMNS`) and ``auto.json`` what was
-        chosen.  Expert mode: adaptive time steps to this relative error per unit time
+        chosen.
+    step_tol : float, optional
+        Expert mode: adaptive time steps to this relative error per unit time
         (:mod:`femehl.solver.adaptive`); ``dt`` is then the first step and the scheme BDF2
         unless given.  ``store_every`` and ``checkpoint_every`` count accepted steps.
     **options
@@ -167,9 +170,9 @@ def run_to_folder(
     SolverError, KeyboardInterrupt
         The run stopped: ``exc.result`` is the partial Result, the files stay readable.
     """
-    from femehl.api import DEFAULT_TOL, is_automatic, refuse_auto_only
+    from femehl.api import DEFAULT_TOL, check_tolerances, is_automatic, refuse_auto_only
 
-    tol = check_tol(tol)
+    tol, step_tol = check_tol(tol), check_tol(step_tol, "step_tol")
     if "max_wall" in options:  # checked before the folder is touched
         from femehl.accuracy.auto import check_max_wall
 
@@ -190,12 +193,13 @@ def run_to_folder(
         saved_auto = checkpoint.read_params(check_folder(folder, resume=True)).get("auto")
     if saved_auto is None and not is_automatic(scene, method, dt, options):
         refuse_auto_only(options)
-        res = _stream(scene, folder, dt=dt, tol=tol, resume=resume, overwrite=overwrite, **common)
-        if not resume and not res.info.get(
-            "nothing_to_do"
-        ):  # the space estimate from the coarser companion (a resumed run: its part only)
-            _expert_estimate(scene, pathlib.Path(folder), res, dt, tol, options, t_end, say)
+        check_tolerances(False, tol, step_tol)
+        res = _stream(scene, folder, dt=dt, step_tol=step_tol, resume=resume, overwrite=overwrite, **common)
+        # the space estimate from the coarser companion (a resumed run: its part only)
+        if not resume and not res.info.get("nothing_to_do"):
+            _expert_estimate(scene, pathlib.Path(folder), res, dt, step_tol, options, t_end, say)
         return res
+    check_tolerances(True, tol, step_tol)
     if dt is not None:
         raise SceneError("an automatic run chooses its time steps: leave dt out (or give the mesh too).")
     return _automatic(
@@ -229,7 +233,7 @@ def _automatic(
             method=method,
             t_end=t_end,
             dt=None,
-            tol=plan["tol_t"],
+            step_tol=plan["tol_t"],
             resume=resume,
             overwrite=overwrite if first["candidate"] or resume else True,
             store_every=store_every,
@@ -352,14 +356,14 @@ def _pilot_bar(desc, t_end):
     return TimeBar(f"femehl {desc}", t_end)
 
 
-def _expert_estimate(scene, folder, res, dt, tol, options, t_end, say) -> None:
+def _expert_estimate(scene, folder, res, dt, step_tol, options, t_end, say) -> None:
     """An expert run's estimate (:func:`femehl.accuracy.auto.expert_estimate`) into summary.csv."""
     from femehl.accuracy.auto import companion_run, expert_estimate
 
-    options = {"scheme": "bdf2", **options} if tol is not None else dict(options)
-    step = (0.01 if dt is None else dt) if tol is None else dt
-    companion, ratio = companion_run(scene, res.method, options, t_end, step, tol, {})
-    res.estimate = expert_estimate(res, companion, ratio, adaptive=tol is not None)
+    options = {"scheme": "bdf2", **options} if step_tol is not None else dict(options)
+    step = (0.01 if dt is None else dt) if step_tol is None else dt
+    companion, ratio = companion_run(scene, res.method, options, t_end, step, step_tol, {})
+    res.estimate = expert_estimate(res, companion, ratio, adaptive=step_tol is not None)
     if res.estimate is not None:
         _write_estimate(folder, res)
         if companion is not None:
@@ -396,7 +400,7 @@ def _stream(
     method,
     t_end,
     dt,
-    tol,
+    step_tol,
     resume,
     overwrite,
     store_every,
@@ -407,24 +411,24 @@ def _stream(
     auto_plan=None,
 ) -> Result:
     """One run of one discretization, written into ``folder`` as it goes."""
-    if tol is not None:
+    if step_tol is not None:
         options = {"scheme": "bdf2", **options}
-    step = 0.01 if dt is None else dt  # fixed steps; with tol only checked (None: the controller's)
+    step = 0.01 if dt is None else dt  # fixed steps; with step_tol only checked (None: the controller's)
     t_end, step, nsteps, store_every, every = check_run_options(t_end, step, store_every, checkpoint_every)
-    dt = step if tol is None or dt is not None else None
+    dt = step if step_tol is None or dt is not None else None
     progress = check_flag("progress", progress)
     folder = check_folder(folder, resume=resume, overwrite=overwrite)
     t0 = time.perf_counter()
     stepper = make_stepper(scene, method, **options)
     params = checkpoint.run_params(scene, stepper, step)
-    params["tol"] = tol
+    params["tol"] = step_tol  # the checkpoint's name for the step controller's tolerance
     if auto_plan is not None:
         params["auto"] = auto_plan
     start = None
     if resume:
         checkpoint.check_params(checkpoint.read_params(folder), params)
         start = checkpoint.load_checkpoint(folder, reference=stepper.initial_state())
-        _check_resume_time(start, t_end, None if tol is not None else dt)
+        _check_resume_time(start, t_end, None if step_tol is not None else dt)
     say(_terms(scene, stepper, t_end) + f"; set-up {time.perf_counter() - t0:.1f} s")
     if "cavitation_note" in stepper.info:
         say(f"femehl: cavitation: {stepper.info['cavitation_note']}")
@@ -494,7 +498,7 @@ def _stream(
     finished = False
     try:
         result = run_loop(
-            stepper, t_end, dt, tol=tol, start=start, store_every=store_every, on_state=on_state
+            stepper, t_end, dt, step_tol=step_tol, start=start, store_every=store_every, on_state=on_state
         )
         finished = True
     except SolverError as exc:

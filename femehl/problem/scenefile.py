@@ -110,12 +110,24 @@ RUN_KEYS = {
     "dtheta_divisions",
     "linear_solver",
     "tol",
+    "step_tol",
     "operator",
     "operator_tol",
     "max_wall",
 }
 #: [run] keys of a line-contact scene ([indenter] kind = "cylinder")
-LINE_RUN_KEYS = {"method", "scheme", "t_end", "dt", "store_every", "n_elements", "grading", "tol", "max_wall"}
+LINE_RUN_KEYS = {
+    "method",
+    "scheme",
+    "t_end",
+    "dt",
+    "store_every",
+    "n_elements",
+    "grading",
+    "tol",
+    "step_tol",
+    "max_wall",
+}
 
 
 def _build(registry, table, where, path):

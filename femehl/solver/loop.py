@@ -73,7 +73,7 @@ def run_loop(
     t_end: float,
     dt: float | None = None,
     *,
-    tol: float | None = None,
+    step_tol: float | None = None,
     start: State | None = None,
     store_every: int = 1,
     on_state: Callable[[State], None] | None = None,
@@ -83,7 +83,7 @@ def run_loop(
 
     Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
     here.  Fixed steps ``dt`` (:func:`femehl.solver.stepping.march`), or adaptive steps to
-    ``tol`` (:func:`femehl.solver.adaptive.march_adaptive`, ``dt`` the first step, ``controls``
+    ``step_tol`` (:func:`femehl.solver.adaptive.march_adaptive`, ``dt`` the first step, ``controls``
     its ``dt_min``, ``dt_max``, ``safety``).  ``start`` resumes from a State (its own
     record is kept, ``on_state`` is not called for it).  If the run stops on a
     :class:`~femehl.errors.SolverError` or is interrupted, the partial Result is attached
@@ -92,16 +92,16 @@ def run_loop(
     """
     if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
         raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
-    if tol is None:
+    if step_tol is None:
         if controls:
-            raise SceneError(f"{sorted(controls)} tune adaptive steps: give tol= as well.")
+            raise SceneError(f"{sorted(controls)} tune adaptive steps: give step_tol= as well.")
         states = march(stepper, t_end, 0.01 if dt is None else dt, start=start)
     else:
         from femehl.solver.adaptive import march_adaptive
 
         if dt is not None:
             controls.setdefault("dt0", dt)
-        states = march_adaptive(stepper, t_end, tol=tol, start=start, **controls)
+        states = march_adaptive(stepper, t_end, tol=step_tol, start=start, **controls)
     result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
     last = None
     rejected, dts = 0, []
@@ -123,9 +123,9 @@ def run_loop(
             result._stored.append(last[0])
         result.info.update(getattr(stepper, "info", {}))  # counters as at the end of the run
         result.info["steps"] = result.nsteps
-        if tol is not None:
+        if step_tol is not None:
             result.info.update(
-                tol=tol,
+                step_tol=step_tol,
                 rejected_steps=rejected,
                 dt_smallest=min(dts, default=math.nan),
                 dt_largest=max(dts, default=math.nan),

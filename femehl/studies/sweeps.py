@@ -345,6 +345,10 @@ def _jsonable(v):
     return v
 
 
+#: the run options every case takes besides its method's
+RUN_OPTIONS = ("method", "t_end", "dt", "store_every", "checkpoint_every", "tol", "step_tol")
+
+
 def check_case_options(scene, options: dict) -> dict:
     """Refuse, before anything runs, run options :func:`femehl.output.run.run_to_folder` would refuse.
 
@@ -358,7 +362,7 @@ def check_case_options(scene, options: dict) -> dict:
     import inspect
 
     from femehl.accuracy.auto import check_max_wall
-    from femehl.api import AUTO_ONLY, is_automatic, refuse_auto_only
+    from femehl.api import AUTO_ONLY, check_tolerances, is_automatic, refuse_auto_only
     from femehl.output._validation import check_run_options, check_tol
     from femehl.solver.linsolve import LINEAR_SOLVERS
     from femehl.solver.loop import _registry
@@ -381,6 +385,7 @@ def check_case_options(scene, options: dict) -> dict:
             "leave method out, or give a scene of that kind."
         )
     check_tol(options.get("tol"))
+    check_tol(options.get("step_tol"), "step_tol")
     if "max_wall" in options:
         check_max_wall(options["max_wall"])
     dt = options.get("dt")
@@ -390,12 +395,10 @@ def check_case_options(scene, options: dict) -> dict:
         options.get("store_every", 10),
         options.get("checkpoint_every"),
     )
-    rest = {
-        k: v
-        for k, v in options.items()
-        if k not in ("method", "t_end", "dt", "store_every", "checkpoint_every", "tol")
-    }
-    if not is_automatic(scene, method, dt, rest):
+    rest = {k: v for k, v in options.items() if k not in RUN_OPTIONS}
+    automatic = is_automatic(scene, method, dt, rest)
+    check_tolerances(automatic, options.get("tol"), options.get("step_tol"))
+    if not automatic:
         refuse_auto_only(rest)
     takes = set(inspect.signature(methods[method]).parameters) - {"scene"}
     takes |= {"scheme", "linear_solver", "terms"} | set(AUTO_ONLY)
@@ -405,7 +408,7 @@ def check_case_options(scene, options: dict) -> dict:
     if unknown:
         raise SceneError(
             f"method {method!r} does not take the run option(s) {unknown}: check the spelling; it takes "
-            f"{sorted(takes | {'t_end', 'dt', 'tol', 'store_every', 'checkpoint_every', 'method'})}."
+            f"{sorted(takes | set(RUN_OPTIONS))}."
         )
     return options
 

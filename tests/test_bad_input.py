@@ -536,3 +536,18 @@ def test_former_escape_now_raises_femehl_error(call):
         with pytest.raises(FemehlError) as info:
             call()
     assert str(info.value).strip()
+
+
+# ---- tol (the automatic mode's accuracy target) and step_tol (expert adaptive steps) -------
+def test_tol_and_step_tol_are_not_mixed_up(tmp_path):
+    sc = femehl.presets.paper_sphere()
+    with pytest.raises(SceneError, match=r"adaptive time steps.*give step_tol="):
+        femehl.solve(sc, t_end=0.1, mesh="coarse", tol=1e-2)
+    with pytest.raises(SceneError, match="step_tol tunes the adaptive steps of an expert run"):
+        femehl.solve(sc, t_end=0.1, step_tol=1e-3)
+    from femehl.cli import main
+
+    assert main(["run", "--mesh", "coarse", "--tol", "0.01", "--out", str(tmp_path / "a")]) == 2
+    assert not (tmp_path / "a").exists()
+    res = femehl.solve(sc, t_end=0.05, mesh="coarse", step_tol=1e-2, estimate=False)
+    assert res.info["step_tol"] == 1e-2 and res.info["rejected_steps"] >= 0

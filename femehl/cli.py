@@ -196,9 +196,7 @@ def _run(args, argv=()):
     else:
         scene, run = presets.paper_sphere(), {}
         name = "paper_sphere"
-    from femehl.problem.line import LineScene
-
-    is_line = isinstance(scene, LineScene)
+    is_line = scene.default_method == "line"
     resume, overwrite = check_resume_overwrite(args.resume, args.overwrite)
     run = run_options(run)
     method = args.method or run.pop("method", "line" if is_line else "fe")

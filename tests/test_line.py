@@ -29,7 +29,7 @@ import scipy.sparse as sp
 from femehl.api import make_stepper, solve_line
 from femehl.errors import SceneError
 from femehl.output.result import Result
-from femehl.problem.line import LineScene, line_nodes
+from femehl.problem.line import LineScene, contact_halfwidth, line_nodes
 from femehl.problem.scene import Constant, Motion, RampHold, Table, TanhStart
 from femehl.reference.line_steady import steady_line, steady_line_load
 from femehl.solver.stepping import State
@@ -221,7 +221,7 @@ def test_imposed_load_sliding_reaches_steady_gap(exact):
 def test_load_given_through_motion():
     """Motion(load=...) (the 2-D convention) works the same; gap(0) is the initial clearance."""
     sc = LineScene(k=K, beta=BETA, L=L, motion=Motion(gap=RampHold(0.1, -0.5, 1.0), load=1.0))
-    assert sc.imposed_load and isinstance(sc.load, Constant)
+    assert sc.motion.load_controlled and isinstance(sc.motion.load, Constant)
     r = solve_line(sc, 1.0, 0.05, n_elements=100)
     assert r.hc[0] == 0.1
     assert np.all(np.abs(r.load[1:] - 1.0) < 1e-10)
@@ -341,9 +341,10 @@ def test_invalid_run_options():
 def test_scene_is_frozen():
     sc = sliding_scene()
     with pytest.raises(dataclasses.FrozenInstanceError):
-        sc.k = 2.0
-    assert LineScene().contact_halfwidth() == pytest.approx(1.0)
-    assert isinstance(LineScene(load=1.0, motion=Motion(gap=0.1)).load, Constant)
+        sc.domain = None
+    # the dry Winkler contact of the default ramp to hc = -0.5: a = sqrt(2 * 0.5)
+    assert contact_halfwidth(LineScene()) == pytest.approx(1.0)
+    assert isinstance(LineScene(load=1.0, motion=Motion(gap=0.1)).motion.load, Constant)
 
 
 # ---------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import pytest
 from femehl.api import make_stepper, solve_line
 from femehl.errors import SceneError
 from femehl.output.checkpoint import describe
-from femehl.problem.line import LineScene
+from femehl.problem.line import LineScene, contact_halfwidth
 from femehl.problem.scene import Constant, Motion, RampHold, TanhStart
 
 
@@ -25,8 +25,8 @@ def test_no_profile_is_the_cylinder_as_before():
         assert r.final.load == pytest.approx(load, rel=1e-13, abs=0.0)
     sc = LineScene(motion=motion())
     x = np.linspace(-2.0, 2.0, 7)
-    assert np.array_equal(sc.shape(x), 0.5 * x * x)
-    assert "profile" not in describe(sc)  # scenes without it describe as before
+    assert np.array_equal(sc.indenter.line_gap(x), 0.5 * x * x)
+    assert describe(sc)["indenter"]["type"] == "Cylinder"
 
 
 def test_profile_equal_to_the_cylinder_gives_the_same_run():
@@ -41,12 +41,12 @@ def test_profile_equal_to_the_cylinder_gives_the_same_run():
 
 def test_profile_scene_and_its_default_mesh():
     sc = LineScene(motion=Motion(gap=Constant(0.2), velocity=1.0), k=1e4, profile=lambda x: 0.1 * (x + 2.0))
-    assert sc.contact_halfwidth() is None
+    assert contact_halfwidth(sc) is None
     x = np.linspace(-2.0, 2.0, 5)
-    assert np.allclose(sc.shape(x), 0.1 * (x + 2.0))
+    assert np.allclose(sc.indenter.line_gap(x), 0.1 * (x + 2.0))
     st = make_stepper(sc, "line", n_elements=40)  # default grading 3: fine zone L/2
     assert np.allclose(st.disc.shape, 0.1 * (st.disc.xc + 2.0))
-    assert "profile" in describe(sc)
+    assert describe(sc)["indenter"]["type"] == "Profile"
     # an offset profile lets hc(0) be negative as long as the film is open
     LineScene(motion=Motion(gap=-0.5, velocity=1.0), profile=lambda x: 1.0 + 0.5 * x * x)
     # a short nearly rigid run: the slider converges toward the outlet -L, p > 0 builds up

@@ -8,7 +8,7 @@ in weak form: find p in P1, p(-L) = p(L) = 0, such that for every P1 test functi
 (the Couette term integrated by parts; its boundary term vanishes since q(+-L) = 0),
 with the forms of :mod:`femehl.discretize.forms`.  The film points are the element centroids
 ``(x_e, 0)``; the shape is the scene's rigid gap
-``LineScene.shape`` (the cylinder ``x^2/2`` or its ``profile``).  The load is per unit length,
+the indenter's ``line_gap`` (the cylinder ``x^2/2`` or a profile).  The load is per unit length,
 ``int p dx``.  Only local substrates (Winkler, rigid) have a line operator; with them
 no dense matrix is built anywhere.
 """
@@ -30,11 +30,12 @@ __all__ = ["LineDisc"]
 
 @register_method("line")
 class LineDisc(P1P0):
-    """A 1-D mesh of ``[-L, L]`` for a :class:`femehl.problem.line.LineScene`.
+    """A 1-D mesh of ``[-L, L]`` for a line contact (a scene on a
+    :class:`femehl.problem.line.LineDomain`, e.g. :func:`femehl.problem.line.LineScene`).
 
     Parameters
     ----------
-    scene : femehl.line.LineScene
+    scene : femehl.Scene
     n_elements : int, default: 400
         Number of P1 elements.
     grading : "uniform", float or callable, default: 3.0
@@ -42,26 +43,28 @@ class LineDisc(P1P0):
         times smaller over the contact (``|x| <= fine``) than at the ends.
     fine : float, optional
         Half width of the fine zone; default ``min(L, a + 0.5)`` with ``a`` the dry
-        contact half width (:meth:`LineScene.contact_halfwidth`), or ``L/2``.
+        contact half width (:func:`femehl.problem.line.contact_halfwidth`), or ``L/2``.
     """
 
     dimension = 1
     default_linear_solver = "lu"
 
     def __init__(self, scene, n_elements: int = 400, grading=3.0, fine=None):
-        from femehl.problem.line import LineScene, line_nodes
+        from femehl.problem.line import contact_halfwidth, line_nodes
 
         t0 = time.perf_counter()
-        if not isinstance(scene, LineScene):
+        if getattr(scene, "default_method", None) != "line":
             raise SceneError(
-                f"method 'line' needs a femehl.line.LineScene, got {type(scene).__name__}: "
+                "method 'line' needs a line contact (femehl.line.LineScene(...), a scene on a "
+                f"LineDomain), got a scene on {type(getattr(scene, 'domain', None)).__name__}: "
                 "use method 'fe' or 'fd' for a 2-D scene."
             )
         self.scene = scene
+        L = scene.domain.L
         if fine is None and not isinstance(grading, str):
-            a = scene.contact_halfwidth()
-            fine = 0.5 * scene.L if a is None else min(scene.L, a + 0.5)
-        x = line_nodes(scene.L, n_elements, grading, fine)
+            a = contact_halfwidth(scene)
+            fine = 0.5 * L if a is None else min(L, a + 0.5)
+        x = line_nodes(L, n_elements, grading, fine)
         self.mesh = MeshLine(x)
         self.basis = b1 = Basis(self.mesh, ElementLineP1())
         self.basis0 = b0 = b1.with_element(ElementLineP0())
@@ -70,7 +73,7 @@ class LineDisc(P1P0):
         self.xc = self.x[t].mean(axis=0)
         ne, nn = t.shape[1], self.x.size
         self.nelements, self.nnodes = ne, nn
-        self.L = scene.L
+        self.L = L
         self.nodes = np.column_stack([self.x, np.zeros(nn)])
         self.film_points = np.column_stack([self.xc, np.zeros(ne)])
         self._build_forms(b1, b0, np.setdiff1d(np.arange(nn), self.mesh.boundary_nodes()))
@@ -84,12 +87,12 @@ class LineDisc(P1P0):
             "grading": grading if not callable(grading) else "callable",
             "h_min": float(np.diff(self.x).min()),
             "h_max": float(np.diff(self.x).max()),
-            "imposed_load": scene.imposed_load,
+            "imposed_load": scene.motion.load_controlled,
             "setup_s": time.perf_counter() - t0,
         }
 
     def gap(self, points):
-        return self.scene.shape(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0])
+        return self.scene.indenter.line_gap(np.asarray(points, dtype=float).reshape(-1, 2)[:, 0])
 
     # ---- substrate primitives (the Reynolds operators come from P1P0) ----------------
     def pressure_rows(self, points):

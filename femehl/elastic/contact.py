@@ -20,6 +20,7 @@ from femehl.errors import SceneError
 __all__ = [
     "DryContact",
     "SampledShape",
+    "LineShape",
     "dry_contact_extent",
     "indentation",
     "elastic_contact",
@@ -219,6 +220,27 @@ class SampledShape:
         """``int (depth - s)+ dA`` over the sampled disk."""
         area = (self.r[1] - self.r[0]) * self.r * (2.0 * math.pi / self.th.size)
         return float(np.sum(np.maximum(depth - self.S, 0.0) @ area))
+
+
+@dataclass(frozen=True)
+class LineShape:
+    """A line contact's cylinder of radius ``R``, per unit length: the 1-D shape a local
+    foundation's :meth:`dry_contact` reads (``overlap_axes``, ``overlap_volume``)."""
+
+    R: float = 1.0
+    radii = None
+
+    def overlap_axes(self, depth: float) -> tuple[float, float]:
+        """``(a, 0)``: the overlap ``x^2/(2R) < depth`` is ``|x| < a = sqrt(2 R depth)``."""
+        return math.sqrt(2.0 * self.R * max(depth, 0.0)), 0.0
+
+    def overlap_radius(self, depth: float) -> float:
+        return self.overlap_axes(depth)[0]
+
+    def overlap_volume(self, depth: float) -> float:
+        """``int (depth - x^2/(2R))+ dx = (2/3) a^3 / R``."""
+        a = self.overlap_axes(depth)[0]
+        return (2.0 / 3.0) * a**3 / self.R
 
 
 def sample_shape(scene) -> SampledShape:

@@ -592,7 +592,7 @@ def line_figure(result):
                 ax.axvspan(a, b, label=lab, **_CAV_SHADE)
     ax1.legend(fontsize=7, ncol=2)
     sc = result.scene
-    fig.suptitle(f"cylinder on Winkler foundation: k = {sc.k:g}, beta = {sc.beta:g}")
+    fig.suptitle(f"{type(sc.indenter).__name__} on {sc.substrate!r}, beta = {sc.fluid.beta:g}", fontsize=9)
     return fig
 
 

@@ -60,20 +60,19 @@ alone.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from femehl.elastic import Winkler
+from femehl.elastic import Viscoelastic, Winkler
 from femehl.errors import SceneError
 from femehl.problem.scene import (
     Constant,
     Fluid,
     Motion,
     RampHold,
-    SceneEffects,
+    Scene,
     Table,
     TanhStart,
     _as_time_function,
@@ -82,7 +81,7 @@ from femehl.problem.scene import (
 )
 from femehl.validation import check_shape_values
 
-__all__ = ["LineScene", "line_nodes"]
+__all__ = ["Cylinder", "Profile", "LineDomain", "LineScene", "contact_halfwidth", "line_nodes"]
 
 
 def _default_motion() -> Motion:
@@ -90,168 +89,47 @@ def _default_motion() -> Motion:
 
 
 # --------------------------------------------------------------------------
-# scene
+# the line contact's indenters and domain
 # --------------------------------------------------------------------------
 @dataclass(frozen=True)
-class LineScene(SceneEffects):
-    """A rigid cylinder (gap ``x^2/2``, or a given profile) on a lubricated Winkler foundation.
+class Cylinder:
+    """A rigid cylinder along y (radius ``R``, normalized): the gap ``x^2 / (2 R)``."""
 
-    Normalized units (module docstring).
-
-    Parameters
-    ----------
-    k : float, default: 1.0
-        Winkler stiffness, ``w = -p/k`` (> 0; a large k is a nearly rigid substrate).
-    beta : float, default: 10.0
-        The paper's film parameter multiplying ``d/dx(d^3 dp/dx)`` (> 0).
-    motion : femehl.problem.scene.Motion, default: ramp 0.1 -> -0.5 for t <= 1, then tanh(t - 1) sliding
-        Tip clearance hc(t) and sliding velocity V(t) (cylinder moves toward +x).
-        With an imposed load, ``motion.gap`` only gives the initial clearance hc(0).
-    L : float, default: 2.0
-        Half length of the domain ``[-L, L]``; p = 0 at both ends.
-    load : callable or float or None, default: None
-        Imposed load per unit length ``F(t) = int p dx``; None imposes the gap
-        instead.  ``motion.load`` is accepted too (and moved here); give one of them.
-    viscosity : femehl.Barus or femehl.Roelands, optional
-        Pressure-dependent viscosity (:mod:`femehl.problem.viscosity`); None: isoviscous.
-    cavitation : {None, "jfo", "reynolds", "half-sommerfeld"}, optional
-        Cavitation condition (:mod:`femehl.problem.cavitation`); None: full Sommerfeld.
-    viscoelastic : femehl.Viscoelastic, optional
-        A viscoelastic foundation: the standard linear solid whose relaxed stiffness is
-        ``k * G_inf`` and unrelaxed ``k * G0`` (its ``elastic`` is the Winkler(k) of this
-        scene; :mod:`femehl.elastic.viscoelastic`); None: elastic.
-    profile : callable, optional
-        The rigid gap ``s(x)`` of the slider, a vectorized function of an array of x
-        returning one finite value per point (e.g. a textured slider,
-        ``lambda x: 0.1 * x + pocket(x)``); the film is ``d = hc + s(x) + p/k``.  It must
-        leave the film open at the start: ``s(x) + hc(0) > 0`` on [-L, L].  None: the
-        cylinder ``x^2/2``.  A callable cannot be written in a scene file.
-    """
-
-    default_method = "line"
-
-    k: float = 1.0
-    beta: float = 10.0
-    motion: Motion = field(default_factory=_default_motion)
-    L: float = 2.0
-    load: Callable[[float], float] | None = None
-    viscosity: object = field(default=None, metadata={"describe": "omit_default"})
-    cavitation: str | None = field(default=None, metadata={"describe": "omit_default"})
-    viscoelastic: object = field(default=None, metadata={"describe": "omit_default"})
-    profile: Callable | None = field(default=None, metadata={"describe": "omit_default"})
+    R: float = 1.0
+    dimension = 1
 
     def __post_init__(self):
-        from femehl.problem.cavitation import check_cavitation
-        from femehl.problem.viscosity import check_viscosity
+        object.__setattr__(self, "R", check_positive("cylinder radius R", self.R))
 
-        check_viscosity(self.viscosity)
-        check_cavitation(self.cavitation)
-        from femehl.elastic import Viscoelastic
+    def line_gap(self, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        return 0.5 * x * x if self.R == 1.0 else 0.5 * x * x / self.R
 
-        if self.viscoelastic is not None and not isinstance(self.viscoelastic, Viscoelastic):
-            raise SceneError(
-                f"LineScene(viscoelastic=...) must be a femehl.Viscoelastic(G0, tau), got "
-                f"{type(self.viscoelastic).__name__}."
-            )
-        object.__setattr__(
-            self,
-            "k",
-            check_positive("Winkler stiffness k", self.k, "Use a large k for a nearly rigid substrate."),
-        )
-        object.__setattr__(
-            self,
-            "beta",
-            check_positive("beta", self.beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation."),
-        )
-        object.__setattr__(
-            self,
-            "L",
-            check_positive("domain half length L", self.L, "The domain is [-L, L]; L = 2 suits hc >= -0.5."),
-        )
-        if not isinstance(self.motion, Motion):
-            raise SceneError(
-                f"LineScene.motion must be a femehl.problem.scene.Motion, got {type(self.motion).__name__}: "
-                "wrap the gap and velocity as Motion(gap=..., velocity=...)."
-            )
-        mload = getattr(self.motion, "load", None)
-        if mload is not None:
-            if self.load is not None:
-                raise SceneError("the load is imposed twice (LineScene.load and Motion.load): give only one.")
-            object.__setattr__(self, "load", mload)
-        if self.load is not None:
-            object.__setattr__(self, "load", _as_time_function("LineScene load F(t)", self.load))
-            check_finite("load F(t=0)", self.load(0.0), "The load history must return finite values.")
-            object.__setattr__(
-                self, "motion", Motion(gap=self.motion.gap, velocity=self.motion.velocity, load=self.load)
-            )
-            times = np.union1d(np.linspace(0.0, 10.0, 201), getattr(self.load, "times", ()))
-            for t in times[times >= 0.0]:
-                self.motion.F(t)  # refuses a negative (pulling) load up front, naming the time
-        hc0 = self.motion.hc(0.0)
-        if self.profile is not None:
-            self._check_profile(hc0)
-        elif hc0 <= 0.0:
-            raise SceneError(
-                f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
-                "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
-                "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
-            )
-        from femehl.problem.cavitation import check_cavitation_scene
+    def gap(self, x, y=None) -> np.ndarray:
+        return self.line_gap(x)
 
-        check_cavitation_scene(self)
-        a = self.contact_halfwidth()
-        if a is not None and self.L < 1.5 * a:
-            raise SceneError(
-                f"domain half length L = {self.L:g} is too small to hold the contact: the dry "
-                f"Winkler contact of this run reaches |x| = {a:.3g}, and the pressure must decay "
-                f"before x = +-L. Use L >= {1.5 * a:.3g}."
-            )
 
-    @property
-    def fluid(self) -> Fluid:
-        """The film's fluid (its ``beta``), as for a 2-D scene."""
-        return Fluid(self.beta)
+@dataclass(frozen=True)
+class Profile:
+    """A slider's rigid gap ``s(x)`` (line contact): a vectorized function of an array of x
+    returning one finite value per point (a textured or inclined slider)."""
 
-    @property
-    def substrate(self):
-        """The Winkler foundation ``w = -p/k`` (relaxing as ``viscoelastic`` says, if given)."""
-        if self.viscoelastic is None:
-            return Winkler(self.k)
-        return dataclasses.replace(self.viscoelastic, elastic=Winkler(self.k))
+    s: Callable
+    dimension = 1
 
-    @property
-    def imposed_load(self) -> bool:
-        """True when the load F(t) is imposed (hc is then an unknown)."""
-        return self.load is not None
-
-    def _check_profile(self, hc0: float) -> None:
-        """SceneError unless ``profile`` is a vectorized, finite gap leaving the film open at t = 0."""
-        if not callable(self.profile):
+    def __post_init__(self):
+        if not callable(self.s):
             raise SceneError(
                 f"LineScene(profile=...) must be a callable s(x) (the rigid gap), got "
-                f"{type(self.profile).__name__}: pass e.g. profile=lambda x: 0.5 * x**2, or None "
+                f"{type(self.s).__name__}: pass e.g. profile=lambda x: 0.5 * x**2, or None "
                 "for the cylinder."
             )
-        xs = np.linspace(-self.L, self.L, 1001)
-        s = self._profile_values(xs)
-        if not np.all(np.isfinite(s)):
-            bad = xs[~np.isfinite(s)][0]
-            raise SceneError(
-                f"LineScene profile s(x) is not finite at x = {bad:.4g}: the rigid gap must be "
-                f"finite on the whole domain [-{self.L:g}, {self.L:g}]."
-            )
-        i = int(np.argmin(s))
-        if s[i] + hc0 <= 0.0:
-            raise SceneError(
-                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= 0 at x = {xs[i]:.4g}: with p = 0 at "
-                f"t = 0 the film must be open everywhere on [-L, L]. Start with hc(0) > {-s[i]:g} "
-                "(and indent with a ramp), or raise the profile."
-            )
 
-    def _profile_values(self, x: np.ndarray) -> np.ndarray:
-        """``profile(x)`` as a new float array of x's shape (SceneError naming the fix)."""
+    def line_gap(self, x) -> np.ndarray:
+        """``s(x)`` as a new float array of x's shape (SceneError naming the fix)."""
+        x = np.asarray(x, dtype=float)
         try:
-            v = self.profile(x)
+            v = self.s(x)
         except SceneError:
             raise
         except Exception as exc:  # noqa: BLE001 - the user's code: say which function failed
@@ -267,41 +145,170 @@ class LineScene(SceneEffects):
             )
         return check_shape_values("LineScene profile s(x)", v, x.shape)
 
-    def shape(self, x):
-        """Rigid gap ``s(x)``: the scene's ``profile``, or the cylinder's ``x^2/2``."""
-        x = np.asarray(x, dtype=float)
-        if self.profile is None:
-            return 0.5 * x * x
-        return self._profile_values(x)
+    def gap(self, x, y=None) -> np.ndarray:
+        return self.line_gap(x)
 
-    def contact_halfwidth(self) -> float | None:
-        """Largest dry (Hertz-Winkler) contact half width of the run, when it can be told.
 
-        Imposed gap: ``a = sqrt(-2 hc_min)`` (0 if the gap stays open).  Imposed
-        load: ``F = (2/3) k a^3``.  None for gap or load histories that are
-        arbitrary callables, and for a user ``profile`` (the estimate is the cylinder's).
-        """
-        if self.profile is not None:
-            return None
-        if self.load is None:
-            gap = self.motion.gap
-            if isinstance(gap, RampHold):
-                hmin = min(gap.h0, gap.h_end)
-            elif isinstance(gap, Table):
-                hmin = min(gap.values)
-            elif isinstance(gap, Constant):
-                hmin = gap.value
-            else:
-                return None
-            return math.sqrt(2.0 * max(0.0, -hmin))
-        F = self.load
-        if isinstance(F, Constant):
-            fmax = F.value
-        elif isinstance(F, Table):
-            fmax = max(F.values)
-        else:
-            return None
-        return (1.5 * max(0.0, fmax) / self.k) ** (1.0 / 3.0)
+@dataclass(frozen=True)
+class LineDomain:
+    """A line contact's domain ``[-L, L]`` (p = 0 at both ends); its method is ``"line"``."""
+
+    L: float = 2.0
+    dimension = 1
+    default_method = "line"
+
+    def __post_init__(self):
+        object.__setattr__(
+            self,
+            "L",
+            check_positive("domain half length L", self.L, "The domain is [-L, L]; L = 2 suits hc >= -0.5."),
+        )
+
+    def check(self, scene) -> None:
+        """SceneError unless ``scene`` is a line contact this domain holds: a 1-D indenter on a
+        local substrate, the film open at t = 0, a load that never pulls, the contact inside."""
+        if getattr(scene.indenter, "dimension", 2) != 1:
+            raise SceneError(
+                f"a line contact's indenter is a femehl.line.Cylinder or a Profile(s), got "
+                f"{type(scene.indenter).__name__}: use femehl.Domain for a 2-D indenter."
+            )
+        if not getattr(scene.substrate, "local", False):
+            raise SceneError(
+                f"line contact takes local substrates only (Winkler, a viscoelastic Winkler, rigid), "
+                f"got {type(scene.substrate).__name__}: the plane-strain deflection of a half space "
+                "is not modelled in 1-D."
+            )
+        motion = scene.motion
+        motion.V(0.0)
+        if motion.load_controlled:
+            times = np.union1d(np.linspace(0.0, 10.0, 201), getattr(motion.load, "times", ()))
+            for t in times[times >= 0.0]:
+                motion.F(t)  # refuses a negative (pulling) load up front, naming the time
+        hc0 = motion.hc(0.0)
+        xs = np.linspace(-self.L, self.L, 1001)
+        s = scene.indenter.line_gap(xs)
+        if not np.all(np.isfinite(s)):
+            bad = xs[~np.isfinite(s)][0]
+            raise SceneError(
+                f"LineScene profile s(x) is not finite at x = {bad:.4g}: the rigid gap must be "
+                f"finite on the whole domain [-{self.L:g}, {self.L:g}]."
+            )
+        i = int(np.argmin(s))
+        if s[i] + hc0 <= 0.0:
+            if isinstance(scene.indenter, Cylinder):
+                raise SceneError(
+                    f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
+                    "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
+                    "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
+                )
+            raise SceneError(
+                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= 0 at x = {xs[i]:.4g}: with p = 0 at "
+                f"t = 0 the film must be open everywhere on [-L, L]. Start with hc(0) > {-s[i]:g} "
+                "(and indent with a ramp), or raise the profile."
+            )
+        a = contact_halfwidth(scene)
+        if a is not None and self.L < 1.5 * a:
+            raise SceneError(
+                f"domain half length L = {self.L:g} is too small to hold the contact: the dry "
+                f"contact of this run reaches |x| = {a:.3g}, and the pressure must decay "
+                f"before x = +-L. Use L >= {1.5 * a:.3g}."
+            )
+
+
+def contact_halfwidth(scene) -> float | None:
+    """Largest dry contact half width of a line contact's run, when it can be told: the
+    cylinder's (a user profile: None), under a gap or load history whose extreme is known
+    (RampHold, Table, Constant; other callables: None), from the substrate's own dry contact
+    (:meth:`dry_contact` on :class:`femehl.elastic.contact.LineShape`)."""
+    from femehl.elastic.contact import LineShape, _dry_contact
+
+    if not isinstance(scene.indenter, Cylinder):
+        return None
+    motion = scene.motion
+    history = motion.load if motion.load_controlled else motion.gap
+    if isinstance(history, RampHold):
+        values = (history.h0, history.h_end)
+    elif isinstance(history, Table):
+        values = tuple(history.values)
+    elif isinstance(history, Constant):
+        values = (history.value,)
+    else:
+        return None
+    dry = _dry_contact(scene.substrate, LineShape(scene.indenter.R))
+    if motion.load_controlled:
+        F = max(0.0, max(values))
+        if F == 0.0 or dry.load is None:
+            return 0.0
+        depth = dry.depth(F)
+    else:
+        depth = max(0.0, -min(values))
+    return float(dry.axes(depth)[0]) if depth > 0.0 else 0.0
+
+
+def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
+    k: float = 1.0,
+    beta: float = 10.0,
+    motion: Motion | None = None,
+    L: float = 2.0,
+    load=None,
+    viscosity=None,
+    cavitation: str | None = None,
+    viscoelastic=None,
+    profile: Callable | None = None,
+) -> Scene:
+    """A line contact: a :class:`femehl.Scene` with a :class:`LineDomain`, a rigid cylinder
+    (or a ``profile``) on a Winkler foundation ``w = -p/k`` (normalized units, module docstring).
+
+    Parameters
+    ----------
+    k : float, default: 1.0
+        Winkler stiffness, ``w = -p/k`` (> 0; a large k is a nearly rigid substrate).
+    beta : float, default: 10.0
+        The paper's film parameter multiplying ``d/dx(d^3 dp/dx)`` (> 0).
+    motion : femehl.Motion, default: ramp 0.1 -> -0.5 for t <= 1, then tanh(t - 1) sliding
+        Tip clearance hc(t) and sliding velocity V(t) (cylinder moves toward +x).
+        With an imposed load, ``motion.gap`` only gives the initial clearance hc(0).
+    L : float, default: 2.0
+        Half length of the domain ``[-L, L]``; p = 0 at both ends.
+    load : callable or float or None, default: None
+        Imposed load per unit length ``F(t) = int p dx``; None imposes the gap
+        instead (``Motion(load=...)`` too; give one of them).
+    viscosity, cavitation
+        The fluid's (:class:`femehl.Fluid`).
+    viscoelastic : femehl.Viscoelastic, optional
+        A viscoelastic foundation relaxing the Winkler(k) (its ``elastic`` is replaced).
+    profile : callable, optional
+        The rigid gap ``s(x)`` of a slider (:class:`Profile`); None: the cylinder ``x^2/2``.
+    """
+    motion = _default_motion() if motion is None else motion
+    if not isinstance(motion, Motion):
+        raise SceneError(
+            f"LineScene.motion must be a femehl.Motion, got {type(motion).__name__}: "
+            "wrap the gap and velocity as Motion(gap=..., velocity=...)."
+        )
+    if load is not None:
+        if motion.load is not None:
+            raise SceneError("the load is imposed twice (LineScene.load and Motion.load): give only one.")
+        load = _as_time_function("LineScene load F(t)", load)
+        check_finite("load F(t=0)", load(0.0), "The load history must return finite values.")
+        motion = Motion(gap=motion.gap, velocity=motion.velocity, load=load)
+    k = check_positive("Winkler stiffness k", k, "Use a large k for a nearly rigid substrate.")
+    beta = check_positive("beta", beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation.")
+    substrate = Winkler(k)
+    if viscoelastic is not None:
+        if not isinstance(viscoelastic, Viscoelastic):
+            raise SceneError(
+                f"LineScene(viscoelastic=...) must be a femehl.Viscoelastic(G0, tau), got "
+                f"{type(viscoelastic).__name__}."
+            )
+        substrate = dataclasses.replace(viscoelastic, elastic=substrate)
+    return Scene(
+        indenter=Cylinder() if profile is None else Profile(profile),
+        substrate=substrate,
+        fluid=Fluid(beta, viscosity=viscosity, cavitation=cavitation),
+        motion=motion,
+        domain=LineDomain(L),
+    )
 
 
 # --------------------------------------------------------------------------

@@ -391,21 +391,34 @@ def _negative_load_message(F: float, t: float) -> str:
 
 @dataclass(frozen=True)
 class Domain:
-    """Computational disk ``r <= L`` (pressure vanishes on r = L)."""
+    """Computational disk ``r <= L`` (pressure vanishes on r = L); its method is ``"fe"``.
+
+    A domain checks the scene it holds (:meth:`check`) and names the scene's default
+    method; a line contact's is :class:`femehl.problem.line.LineDomain`.
+    """
 
     L: float = 2.0
+    dimension = 2
+    default_method = "fe"
 
     def __post_init__(self):
         object.__setattr__(self, "L", check_positive("Domain radius L", self.L))
 
+    def check(self, scene) -> None:
+        """SceneError unless the disk holds ``scene``'s run (film open at t = 0, contact inside)."""
+        hc0 = scene.motion.hc(0.0)
+        scene.motion.V(0.0)  # a velocity history that fails at t = 0 is refused now
+        if hc0 <= 0.0:
+            raise SceneError(
+                f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
+                "film thickness d = hc + s would be <= 0 at the tip. Start with a positive gap "
+                "(the paper case uses h0 = +0.1)."
+            )
+        scene._check_domain_holds_contact()
+
 
 class SceneEffects:
-    """What a scene calls for over a run: shared by :class:`Scene` and ``LineScene``.
-
-    ``default_method`` is the method ``femehl.solve`` uses when none is given.
-    """
-
-    default_method = "fe"
+    """What a scene calls for over a run."""
 
     def has_sliding(self, t_end: float, n: int = 2001) -> bool:
         ts = np.linspace(0.0, t_end, n)
@@ -449,23 +462,25 @@ class Scene(SceneEffects):
         """The fluid's cavitation condition (None: full Sommerfeld)."""
         return self.fluid.cavitation
 
+    @property
+    def default_method(self) -> str:
+        """The method ``femehl.solve`` uses when none is given: the domain's."""
+        return self.domain.default_method
+
     def __post_init__(self):
-        for name, cls in (("fluid", Fluid), ("motion", Motion), ("domain", Domain)):
+        for name, cls in (("fluid", Fluid), ("motion", Motion)):
             if not isinstance(getattr(self, name), cls):
                 raise SceneError(
                     f"Scene.{name} must be a {cls.__name__}, got {type(getattr(self, name)).__name__}."
                 )
+        if not (callable(getattr(self.domain, "check", None)) and hasattr(self.domain, "default_method")):
+            raise SceneError(
+                f"Scene.domain must be a femehl.Domain (a disk) or a femehl.line.LineDomain (line "
+                f"contact), got {type(self.domain).__name__}."
+            )
         if not hasattr(self.indenter, "gap"):
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
-        hc0 = self.motion.hc(0.0)
-        self.motion.V(0.0)  # a velocity history that fails at t = 0 is refused now
-        if hc0 <= 0.0:
-            raise SceneError(
-                f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
-                "film thickness d = hc + s would be <= 0 at the tip. Start with a positive gap "
-                "(the paper case uses h0 = +0.1)."
-            )
-        self._check_domain_holds_contact()
+        self.domain.check(self)
         from femehl.problem.cavitation import check_cavitation_scene
 
         check_cavitation_scene(self)

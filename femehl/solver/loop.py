@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 from femehl.errors import SceneError, SolverError
 from femehl.output.result import Result
-from femehl.problem.scene import SceneEffects
+from femehl.problem.scene import Scene
 from femehl.solver.stepping import State, march
 from femehl.solver.threads import one_blas_thread
 
@@ -40,9 +40,10 @@ def make_stepper(scene, method: str | None = None, **options):
     from femehl.solver.stepper import LaggedStepper
 
     methods = _registry()
-    if not isinstance(scene, SceneEffects):
+    if not isinstance(scene, Scene):
         raise SceneError(
-            f"scene must be a femehl.Scene (or femehl.line.LineScene), got {type(scene).__name__}."
+            f"scene must be a femehl.Scene (femehl.line.LineScene(...) makes a line contact's), "
+            f"got {type(scene).__name__}."
         )
     if method is None:
         method = scene.default_method

@@ -33,21 +33,14 @@ What a discretization provides (all built once, from the scene):
 
 from __future__ import annotations
 
+from femehl.registry import Registry
+
 __all__ = ["METHODS", "register_method", "method_class"]
 
 #: name -> discretization class
-METHODS: dict[str, type] = {}
-
-
-def register_method(name: str):
-    """Class decorator adding a discretization to :data:`METHODS` under ``name``."""
-
-    def deco(cls):
-        cls.method = name
-        METHODS[name] = cls
-        return cls
-
-    return deco
+METHODS = Registry("method", stamp="method")
+#: class decorator adding a discretization to :data:`METHODS`: ``@register_method("fe")``
+register_method = METHODS.register
 
 
 def _load():

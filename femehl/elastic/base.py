@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from typing import Protocol, runtime_checkable
 
+from femehl.registry import Registry
+
 __all__ = [
     "Substrate",
     "SUBSTRATES",
@@ -15,7 +17,7 @@ __all__ = [
 ]
 
 #: kind -> substrate class (the names of ``[substrate] kind`` in scene files)
-SUBSTRATES: dict[str, type] = {}
+SUBSTRATES = Registry("substrate", key="kind")
 
 #: the FE elastic operators (``operator=``): a substrate builds all of them unless its
 #: ``operators`` says otherwise
@@ -35,10 +37,8 @@ def step_limit(substrate, scene, disc, t_end: float) -> float:
     return math.inf if limit is None else float(limit(scene, disc, t_end))
 
 
-def register_substrate(cls):
-    """Class decorator adding a substrate class to :data:`SUBSTRATES` under ``cls.kind``."""
-    SUBSTRATES[cls.kind] = cls
-    return cls
+#: class decorator adding a substrate class to :data:`SUBSTRATES` under ``cls.kind``
+register_substrate = SUBSTRATES.register
 
 
 @runtime_checkable

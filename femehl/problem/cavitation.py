@@ -67,6 +67,7 @@ import dataclasses
 import numpy as np
 
 from femehl.errors import SceneError
+from femehl.registry import Registry
 
 __all__ = [
     "CAVITATION_MODELS",
@@ -82,13 +83,9 @@ __all__ = [
 ]
 
 #: name -> cavitation model class (``Fluid(cavitation=name)``)
-CAVITATION_MODELS: dict[str, type] = {}
-
-
-def register_cavitation(cls):
-    """Class decorator adding a cavitation model to :data:`CAVITATION_MODELS`."""
-    CAVITATION_MODELS[cls.name] = cls
-    return cls
+CAVITATION_MODELS = Registry("cavitation condition", key="name")
+#: class decorator adding a cavitation model to :data:`CAVITATION_MODELS` under ``cls.name``
+register_cavitation = CAVITATION_MODELS.register
 
 
 class _Model:

@@ -38,18 +38,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from femehl.errors import SceneError
+from femehl.registry import Registry
 from femehl.validation import check_nonnegative, check_positive
 
 __all__ = ["VISCOSITY_MODELS", "Barus", "PiezoviscousMobility", "Roelands", "register_viscosity"]
 
 #: kind -> viscosity model class (TOML ``[fluid.viscosity] kind = ...``)
-VISCOSITY_MODELS: dict[str, type] = {}
-
-
-def register_viscosity(cls):
-    """Class decorator adding a viscosity model to :data:`VISCOSITY_MODELS` under ``cls.kind``."""
-    VISCOSITY_MODELS[cls.kind] = cls
-    return cls
+VISCOSITY_MODELS = Registry("viscosity model", key="kind")
+#: class decorator adding a viscosity model to :data:`VISCOSITY_MODELS` under ``cls.kind``
+register_viscosity = VISCOSITY_MODELS.register
 
 
 def _pressure_scale(dim) -> float:

@@ -66,6 +66,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from femehl.errors import SceneError, SingularSystemError
+from femehl.registry import Registry
 from femehl.validation import check_in_range
 
 __all__ = [
@@ -407,18 +408,9 @@ _MAX_TRACKED = 8
 _PROBES = 2
 
 #: name -> linear solver class
-LINEAR_SOLVERS: dict[str, type] = {}
-
-
-def register_linear_solver(name: str):
-    """Class decorator adding a linear solver to :data:`LINEAR_SOLVERS`."""
-
-    def deco(cls):
-        cls.name = name
-        LINEAR_SOLVERS[name] = cls
-        return cls
-
-    return deco
+LINEAR_SOLVERS = Registry("linear solver", stamp="name")
+#: class decorator adding a linear solver to :data:`LINEAR_SOLVERS`: ``@register_linear_solver("lu")``
+register_linear_solver = LINEAR_SOLVERS.register
 
 
 def make_linear_solver(name, **options):

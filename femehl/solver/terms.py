@@ -30,6 +30,7 @@ from typing import Protocol
 import numpy as np
 
 from femehl.errors import SceneError
+from femehl.registry import Registry
 
 __all__ = [
     "Contribution",
@@ -95,13 +96,9 @@ class Term(Protocol):
 
 
 #: name -> term class, in the order they are assembled
-TERMS: dict[str, type] = {}
-
-
-def register_term(cls):
-    """Class decorator adding a term to :data:`TERMS` under ``cls.name``."""
-    TERMS[cls.name] = cls
-    return cls
+TERMS = Registry("term", key="name")
+#: class decorator adding a term to :data:`TERMS` under ``cls.name``
+register_term = TERMS.register
 
 
 def terms_for(scene, t_end=None, extra=()) -> list:

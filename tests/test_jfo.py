@@ -34,15 +34,14 @@ from femehl.problem.scene import Constant, Fluid, Motion, RampHold
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
 
-@dataclasses.dataclass(frozen=True)
-class _TwoConstrictions(LineScene):
+def _two_constrictions_gap(x):
+    return 0.5 * x * x - 0.7 * np.exp(-(((x + 1.2) / 0.2) ** 2))
+
+
+def _TwoConstrictions(**kw):  # noqa: N802 - a scene kind, as LineScene
     """The rigid cylinder with a bump downstream of its minimum (x = -1.2): the film
     ruptures behind the minimum and reforms at the bump."""
-
-    @staticmethod
-    def shape(x):
-        x = np.asarray(x, dtype=float)
-        return 0.5 * x * x - 0.7 * np.exp(-(((x + 1.2) / 0.2) ** 2))
+    return LineScene(profile=_two_constrictions_gap, **kw)
 
 
 def _slider(cavitation, scene=LineScene, t_end=4.0, n=400, dt=0.05, **kw):

@@ -417,8 +417,25 @@ class Domain:
         scene._check_domain_holds_contact()
 
 
-class SceneEffects:
-    """What a scene calls for over a run."""
+@dataclass(frozen=True)
+class Scene:
+    """Everything a solver needs to know about the physics, in normalized units."""
+
+    indenter: Sphere = field(default_factory=Sphere)
+    substrate: HalfSpace | Layer | Rigid | Winkler = field(default_factory=HalfSpace)
+    fluid: Fluid = field(default_factory=Fluid)
+    motion: Motion = field(default_factory=Motion)
+    domain: Domain = field(default_factory=Domain)
+
+    @property
+    def viscosity(self):
+        """The fluid's pressure-viscosity model (None: isoviscous)."""
+        return self.fluid.viscosity
+
+    @property
+    def cavitation(self):
+        """The fluid's cavitation condition (None: full Sommerfeld)."""
+        return self.fluid.cavitation
 
     def has_sliding(self, t_end: float, n: int = 2001) -> bool:
         ts = np.linspace(0.0, t_end, n)
@@ -440,27 +457,6 @@ class SceneEffects:
             "imposed_load": self.motion.load_controlled,
             **({"free_indenter": True} if self.motion.free else {}),
         }
-
-
-@dataclass(frozen=True)
-class Scene(SceneEffects):
-    """Everything a solver needs to know about the physics, in normalized units."""
-
-    indenter: Sphere = field(default_factory=Sphere)
-    substrate: HalfSpace | Layer | Rigid | Winkler = field(default_factory=HalfSpace)
-    fluid: Fluid = field(default_factory=Fluid)
-    motion: Motion = field(default_factory=Motion)
-    domain: Domain = field(default_factory=Domain)
-
-    @property
-    def viscosity(self):
-        """The fluid's pressure-viscosity model (None: isoviscous)."""
-        return self.fluid.viscosity
-
-    @property
-    def cavitation(self):
-        """The fluid's cavitation condition (None: full Sommerfeld)."""
-        return self.fluid.cavitation
 
     @property
     def default_method(self) -> str:

@@ -219,7 +219,9 @@ def test_half_sommerfeld_line_area_fd_and_refusals(tmp_path):
     sc = LineScene(k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L)
     opts = dict(t_end=1.0, step_tol=1e-3, n_elements=100, estimate=False, linear_solver="lu")
     a = femehl.solve(sc, **opts)
-    b = femehl.solve(dataclasses.replace(sc, fluid=Fluid(sc.fluid.beta, cavitation="half-sommerfeld")), **opts)
+    b = femehl.solve(
+        dataclasses.replace(sc, fluid=Fluid(sc.fluid.beta, cavitation="half-sommerfeld")), **opts
+    )
     assert np.array_equal(a.t, b.t)
     paper = femehl.presets.paper_sphere()
     fd = dict(t_end=0.2, dt=0.1, method="fd", dr=0.1, dtheta=math.pi / 12)

@@ -319,7 +319,7 @@ def test_stiff_scene_rejects_and_retries(caplog):
     stepper = make_stepper(scene, "fe", mesh="coarse", scheme="bdf2")
     with caplog.at_level(logging.DEBUG, logger="femehl"):
         with pytest.raises(SolverError) as adaptive:
-            run_loop(stepper, 2.0, tol=0.3, dt_max=0.05, dt_min=1e-4, store_every=0)
+            run_loop(stepper, 2.0, step_tol=0.3, dt_max=0.05, dt_min=1e-4, store_every=0)
     exc = adaptive.value
     assert isinstance(exc, FilmRuptureError) and exc.reason == "closes"
     assert "the film closes (solid contact)" in str(exc)

@@ -39,9 +39,9 @@ def test_cli_refuses_a_tol_that_is_not_a_relative_error(tmp_path, capsys):
 
 def test_scene_file_run_tol(tmp_path):
     path = tmp_path / "s.toml"
-    path.write_text('[fluid]\nbeta = 200.0\n[run]\ntol = 0.02\nt_end = 0.5\nmesh = "coarse"\n')
+    path.write_text('[fluid]\nbeta = 200.0\n[run]\nstep_tol = 0.02\nt_end = 0.5\nmesh = "coarse"\n')
     _, run = load_scene_file(path)
-    assert run["tol"] == 0.02
+    assert run["step_tol"] == 0.02
     out = tmp_path / "o"
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 0
     t = _times(out)

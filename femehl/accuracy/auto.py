@@ -425,8 +425,8 @@ def _run(
     loop (:func:`femehl.solver.loop.run_scene`).
 
     A run that may be the answer (``previous``, the run before it, given; or its ``plan``,
-    a resumed one) is written into ``folder`` (a :class:`~femehl.output.run.RunFolder`, if any) as it goes, and always
-    finishes; the others run in memory, and one still going at ``deadline``
+    a resumed one) is written into ``folder`` (a :class:`~femehl.output.run.RunFolder`,
+    if any) as it goes, and always finishes; the others run in memory, and one still going at ``deadline``
     (``time.perf_counter()``) raises :class:`_OutOfTime`.  ``progress(desc, t_end,
     t_start)``, when given, makes a State handler with a ``close()`` (a progress bar).
     """

@@ -287,7 +287,8 @@ class _Writer:
         where = self.folder.path
         if self.plan is not None and self.plan.get("replaces"):
             self.folder.say(
-                f"femehl: automatic: this finer run replaces the coarser one's {len(removed)} file(s) in {where}"
+                f"femehl: automatic: this finer run replaces the coarser one's {len(removed)} "
+                f"file(s) in {where}"
             )
         else:
             self.folder.say(

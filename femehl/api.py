@@ -212,7 +212,6 @@ def _automatic(scene, method, *, tol, step_tol, estimate, saved, dt, t_end, stor
     if folder is not None:
         folder.check(t_end, None, store_every)
     if saved is not None:
-        kw.pop("callback")
         return auto.resume_to_tolerance(
             scene, folder, saved, t_end=t_end, method=method, store_every=store_every, **kw
         )

@@ -78,11 +78,17 @@ def solve(
     store_every: int = 1,
     callback: Callable[[State], None] | None = None,
     estimate: bool = True,
+    out=None,
+    overwrite: bool = False,
+    resume: bool = False,
+    progress: bool = False,
+    checkpoint_every: int | None = None,
+    log: Callable[[str], None] | None = None,
     **options,
 ) -> Result:
     """Run ``scene`` from t = 0 to ``t_end`` and return a :class:`~femehl.output.result.Result`.
 
-    Two modes:
+    Two modes, decided here once (docs/design.md sections 8 and 9):
 
     * **automatic** (neither ``dt`` nor a discretization option such as ``mesh`` is
       given): femehl chooses the mesh and the time steps so that the load, central and
@@ -96,6 +102,10 @@ def solve(
       from a companion run twice as coarse with the same steps (FE ladder rungs and
       ``"fitted"``, line contact; about 10-25 % more work; ``estimate=False`` skips it)
       and, with ``step_tol``, the time part (:func:`femehl.accuracy.auto.expert_estimate`).
+
+    With ``out`` a folder, the run is written there as it goes
+    (:class:`femehl.output.run.RunFolder`: summary.csv with the estimate's columns,
+    field series, checkpoint, PNGs, auto.json).
 
     Parameters
     ----------
@@ -118,34 +128,127 @@ def solve(
         local error per unit time; the scheme is then BDF2 unless given.  ``dt_min``,
         ``dt_max`` and ``safety`` tune the controller.
     store_every : int, default: 1
-        Keep the fields of every ``store_every``-th step (and the last); 0 keeps none.
+        Keep (and with ``out``, write) the fields of every ``store_every``-th step (and
+        the last); 0 keeps none.
     callback : callable, optional
         Called with each State as it is produced (progress bars, writers); in automatic
         mode with the States of every run (``state.info`` has no level: use
         ``result.info["auto"]`` afterwards).
     estimate : bool, default: True
         Expert mode: also run the coarser companion for the space estimate.
+    out : path-like, optional
+        A run folder to write the run into as it goes.  Refused (OutputError) when it
+        holds a run, unless ``overwrite`` (its femehl files are replaced; other files
+        stay) or ``resume`` (continued from its checkpoint: same scene, method and mesh;
+        summary.csv is appended; the Result starts at the checkpoint).
+    overwrite, resume : bool, default: False
+        See ``out``.
+    progress : bool, default: False
+        A tqdm progress bar for each run.
+    checkpoint_every : int, optional
+        With ``out``: save the state to ``checkpoint.npz`` every this many steps (default:
+        ``store_every``; 0: only at the end) and at the end (:mod:`femehl.output.checkpoint`).
+    log : callable, optional
+        With ``out``: also given each report line (they go to the logger ``"femehl"``).
     **options
         Options of the method (FD ``dr``, ``dtheta``; FE ``mesh``; line ``n_elements``)
         and of the stepper (``scheme``, ``linear_solver``, ``terms``, ...).
+
+    Raises
+    ------
+    SceneError, OutputError
+        A bad option or an unusable folder, before anything is written.
+    SolverError, KeyboardInterrupt
+        The run stopped: ``exc.result`` is the partial Result; a folder's files stay readable.
     """
+    from femehl.output._validation import check_flag, check_tol
+
+    tol, step_tol = check_tol(tol), check_tol(step_tol, "step_tol")
+    if "max_wall" in options:  # checked before a folder is touched
+        from femehl.accuracy.auto import check_max_wall
+
+        options["max_wall"] = check_max_wall(options["max_wall"])
+    bars = _bars(check_flag("progress", progress))
+    folder = _folder(out, overwrite=overwrite, resume=resume, checkpoint_every=checkpoint_every, log=log)
+    saved = None if folder is None else folder.saved_plan()
+    automatic = saved is not None or is_automatic(scene, method, dt, options)
+    check_tolerances(automatic, tol, step_tol)
+    run = _automatic if automatic else _expert
+    kw = dict(t_end=t_end, dt=dt, store_every=store_every, callback=callback, folder=folder, progress=bars)
+    result = run(scene, method, tol=tol, step_tol=step_tol, estimate=estimate, saved=saved, **kw, **options)
+    return result if folder is None else folder.finish(result)
+
+
+def _folder(out, **kw):
+    """The :class:`~femehl.output.run.RunFolder` of ``out`` (None: in memory, and no folder
+    option may be given)."""
+    from femehl.output.run import RunFolder
+
+    if out is not None:
+        return RunFolder(out, **kw)
+    given = sorted(k for k, v in kw.items() if v not in (None, False))
+    if given:
+        raise SceneError(
+            f"{', '.join(given)} apply to a run folder: give out= (the folder), or leave them out."
+        )
+    return None
+
+
+def _bars(progress: bool):
+    """The progress-bar maker of every run (None: no bars)."""
+    from femehl.output.progress import time_bar
+
+    return time_bar if progress else None
+
+
+def _automatic(scene, method, *, tol, step_tol, estimate, saved, dt, t_end, store_every, folder, **kw):
+    """The automatic mode: the sequence (:mod:`femehl.accuracy.auto`), or its saved
+    candidate going on (a resumed run folder)."""
+    from femehl.accuracy import auto
+
+    if dt is not None:
+        raise SceneError("an automatic run chooses its time steps: leave dt out (or give the mesh too).")
+    method = scene.default_method if method is None else method
+    if folder is not None:
+        folder.check(t_end, None, store_every)
+    if saved is not None:
+        return auto.resume_to_tolerance(
+            scene, folder, saved, t_end=t_end, method=method, store_every=store_every, **kw
+        )
+    return auto.solve_to_tolerance(
+        scene,
+        t_end=t_end,
+        tol=DEFAULT_TOL if tol is None else tol,
+        method=method,
+        store_every=store_every,
+        folder=folder,
+        **kw,
+    )
+
+
+def _expert(
+    scene,
+    method,
+    *,
+    tol,
+    step_tol,
+    estimate,
+    saved,
+    dt,
+    t_end,
+    store_every,
+    callback,
+    folder,
+    progress,
+    **options,
+):
+    """The expert mode: one run on the given discretization, and its coarser companion
+    for the space estimate (:func:`femehl.accuracy.auto.companion_run`)."""
+    from femehl.accuracy.auto import companion_run, expert_estimate
+    from femehl.solver import loop
     from femehl.solver.adaptive import CONTROLS
     from femehl.solver.stepping import check_run
 
-    automatic = is_automatic(scene, method, dt, options)
-    check_tolerances(automatic, tol, step_tol)
-    if automatic:
-        from femehl.accuracy.auto import solve_to_tolerance
-
-        return solve_to_tolerance(
-            scene,
-            t_end=t_end,
-            tol=DEFAULT_TOL if tol is None else tol,
-            method=method,
-            store_every=store_every,
-            callback=callback,
-            **options,
-        )
     refuse_auto_only(options)
     controls = {k: options.pop(k) for k in CONTROLS if k in options}
     if step_tol is None:
@@ -153,17 +256,25 @@ def solve(
         check_run(t_end, dt)
     else:
         options.setdefault("scheme", "bdf2")
-    stepper = make_stepper(scene, method, **options)
-    result = run_loop(
-        stepper, t_end, dt, step_tol=step_tol, store_every=store_every, on_state=callback, **controls
+    if folder is not None:
+        folder.check(t_end, dt, store_every)
+    method = scene.default_method if method is None else method
+    result = loop.run_scene(
+        scene,
+        method,
+        options,
+        t_end,
+        dt,
+        step_tol=step_tol,
+        store_every=store_every,
+        on_state=callback,
+        sink=folder,
+        progress=progress,
+        **controls,
     )
-    from femehl.accuracy.auto import companion_run, expert_estimate
-
-    companion, ratio = (
-        companion_run(scene, stepper.method, options, t_end, dt, step_tol, controls)
-        if estimate
-        else (None, None)
-    )
+    if not estimate or folder is not None and folder.resume or result.info.get("nothing_to_do"):
+        return result  # a resumed run: no companion for its part only
+    companion, ratio = companion_run(scene, result.method, options, t_end, dt, step_tol, controls)
     result.estimate = expert_estimate(result, companion, ratio, adaptive=step_tol is not None)
     return result
 

@@ -28,6 +28,7 @@ import pytest
 
 import femehl
 from femehl.accuracy.auto import QUANTITIES, solve_to_tolerance, time_tolerance
+from femehl.accuracy.estimate import Estimate
 from femehl.problem.line import LineScene
 
 REFERENCE = pathlib.Path(__file__).parents[1] / "benchmarks" / "auto_reference.json"
@@ -80,7 +81,7 @@ def test_an_expert_fixed_step_run_has_the_space_part():
 def test_uncertainty_refuses_bad_names_and_times():
     res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.02, dt=0.01, mesh="coarse")
     z = np.zeros(3)
-    res.estimate = {"t": res.t, "load": {"space": z, "time": z + 1e-3, "total": z + 1e-3}}
+    res.estimate = Estimate(res.t, {"load": {"space": z, "time": z + 1e-3, "total": z + 1e-3}}, "pair")
     assert res.uncertainty("load", 0.015) == pytest.approx({"total": 1e-3, "space": 0.0, "time": 1e-3})
     with pytest.raises(femehl.SceneError, match="no error estimate"):
         res.uncertainty("p_max", 0.01)
@@ -183,8 +184,9 @@ def test_an_estimate_near_tol_is_not_accepted(monkeypatch):
 
     def scaled(fine, coarse, ratio):
         est = real(fine, coarse, ratio)
-        k = next(worst) / auto._worst(est)
-        return {"t": est["t"], **{q: {p: v * k for p, v in est[q].items()} for q in QUANTITIES}}
+        k = next(worst) / est.worst()
+        errors = {q: {p: v * k for p, v in est[q].items()} for q in QUANTITIES}
+        return dataclasses.replace(est, errors=errors)
 
     monkeypatch.setattr(auto, "estimate", scaled)
     seen = []

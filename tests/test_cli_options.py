@@ -11,6 +11,7 @@ import pytest
 
 import femehl
 import femehl.output.run
+import femehl.solver.loop
 from femehl.cli import main, resume_command
 from femehl.errors import SceneError
 from femehl.output._validation import (
@@ -130,7 +131,7 @@ def test_existing_run_needs_overwrite_or_resume(tmp_path, capsys):
 
 
 def test_ctrl_c_exits_130_and_prints_the_resume_command(tmp_path, capsys, monkeypatch):
-    real = femehl.output.run.make_stepper
+    real = femehl.solver.loop.make_stepper
 
     def make(*a, **k):
         stepper = real(*a, **k)
@@ -145,7 +146,7 @@ def test_ctrl_c_exits_130_and_prints_the_resume_command(tmp_path, capsys, monkey
         stepper.step = step
         return stepper
 
-    monkeypatch.setattr(femehl.output.run, "make_stepper", make)
+    monkeypatch.setattr(femehl.solver.loop, "make_stepper", make)
     out = tmp_path / "o"
     argv = BASE + ["--t-end", "0.1", "--out", str(out)]
     assert main(argv) == 130

@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 
 import femehl
 import femehl.output.run
+import femehl.solver.loop
 from femehl.errors import CheckpointError, OutputError, SceneError
 from femehl.output import checkpoint, write_all
 from femehl.output.run import run_to_folder
@@ -294,7 +295,7 @@ def test_a_write_failure_names_the_folder_and_keeps_the_last_checkpoint(tmp_path
 # ---- Ctrl-C ----------------------------------------------------------------------------------
 def interrupting(after: int):
     """A make_stepper whose stepper raises KeyboardInterrupt in its step number ``after + 1``."""
-    real = femehl.output.run.make_stepper
+    real = femehl.solver.loop.make_stepper
 
     def make(*a, **k):
         stepper = real(*a, **k)
@@ -314,7 +315,7 @@ def interrupting(after: int):
 
 def test_interrupt_leaves_readable_output_and_resumes(tmp_path, monkeypatch):
     out = tmp_path / "o"
-    monkeypatch.setattr(femehl.output.run, "make_stepper", interrupting(3))
+    monkeypatch.setattr(femehl.solver.loop, "make_stepper", interrupting(3))
     with pytest.raises(KeyboardInterrupt) as info:
         run_to_folder(SC, out, t_end=0.1, mesh="coarse", dt=0.02, store_every=2, checkpoint_every=10)
     assert info.value.result.t[-1] == pytest.approx(0.06)

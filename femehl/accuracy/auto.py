@@ -88,6 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from femehl.accuracy.estimate import Estimate
 from femehl.errors import SceneError, SolverError, TimeBudgetError
 from femehl.output.result import Result
 from femehl.solver.adaptive import LOAD_FLOOR, UNIT_STEP, breakpoints_of
@@ -339,10 +340,8 @@ def companion_run(scene, method, options, t_end, dt, step_tol, controls) -> tupl
         return None, None
 
 
-def expert_estimate(
-    res: Result, companion: Result | None, ratio: float | None, adaptive: bool
-) -> dict | None:
-    """The estimate of an expert run (its own mesh and steps).
+def expert_estimate(res: Result, companion: Result | None, ratio: float | None, adaptive: bool):
+    """The :class:`~femehl.accuracy.estimate.Estimate` of an expert run (its own mesh and steps).
 
     ``space``: the running maximum of ``|q - q_c| / (ratio**2 - 1)`` against a
     ``companion`` run ``ratio`` times coarser in space with the same time steps (fixed
@@ -354,19 +353,20 @@ def expert_estimate(
     if companion is None and not adaptive:
         return None
     et = time_error(res) if adaptive else None
-    out = {"t": res.t}
+    errors = {}
     for name in QUANTITIES:
         space = None
         if companion is not None:
             space = np.maximum.accumulate(pair_error(res, companion, name, ratio))
         tpart = None if et is None else et.copy()
         total = space + tpart if space is not None and tpart is not None else None
-        out[name] = {"total": total, "space": space, "time": tpart}
-    return out
+        errors[name] = {"total": total, "space": space, "time": tpart}
+    how = "controller" if companion is None else "companion"
+    return Estimate(res.t, errors, how, ratio)
 
 
-def estimate(fine: Result, coarse: Result, ratio: float) -> dict:
-    """``{"t": fine.t, name: {"total", "space", "time"}}`` for every quantity.
+def estimate(fine: Result, coarse: Result, ratio: float) -> Estimate:
+    """The pair :class:`~femehl.accuracy.estimate.Estimate` of ``fine`` against ``coarse``.
 
     ``total`` is the running maximum over the steps so far of the pair estimate
     (:func:`pair_error`, space and time together): the pair difference changes sign in
@@ -375,12 +375,13 @@ def estimate(fine: Result, coarse: Result, ratio: float) -> dict:
     (:func:`time_error`) but at most ``total``; ``space = total - time``.
     """
     et = time_error(fine)
-    out = {"t": fine.t}
+    errors = {}
     for name in QUANTITIES:
         total = np.maximum.accumulate(pair_error(fine, coarse, name, ratio))
         tpart = np.minimum(et, total)
-        out[name] = {"total": total, "space": total - tpart, "time": tpart}
-    return out
+        errors[name] = {"total": total, "space": total - tpart, "time": tpart}
+    levels = tuple(float(r.info["level"]) for r in (fine, coarse) if "level" in r.info)
+    return Estimate(fine.t, errors, "pair", ratio, levels)
 
 
 class CompanionSeries:
@@ -404,17 +405,6 @@ def companion_record(res) -> dict:
     }
 
 
-def _worst(est: dict, part: str = "total") -> float:
-    return max(float(np.max(est[q][part])) for q in QUANTITIES)
-
-
-def _where(est: dict) -> str:
-    """``"film_min at t = 0.04"``: the quantity and time of the largest total estimate."""
-    name = max(QUANTITIES, key=lambda q: float(np.max(est[q]["total"])))
-    k = int(np.argmax(est[name]["total"]))
-    return f"{name} at t = {float(est['t'][k]):.4g}"
-
-
 # ---- the driver --------------------------------------------------------------------------
 def _run(
     scene,
@@ -424,46 +414,50 @@ def _run(
     level,
     store_every,
     options,
-    runner=None,
+    folder=None,
     previous=None,
     deadline=None,
     progress=None,
+    tol=None,
+    plan=None,
 ) -> Result:
-    """One adaptive run at ``level`` (its discretization from ``ladder``).
+    """One adaptive run at ``level`` (its discretization from ``ladder``) through the one
+    loop (:func:`femehl.solver.loop.run_scene`).
 
-    ``runner(level=, tol_t=, options=, previous=)`` makes the runs that may be accepted
-    (a run folder writes them as they go); the others, and all of them without a
-    runner, run in memory through the one loop (:func:`femehl.solver.loop.run_loop`).  A run in
-    memory still going at ``deadline`` (``time.perf_counter()``) raises
-    :class:`_OutOfTime`.  ``progress(desc, t_end)``, when given, makes a State handler with
-    a ``close()`` (a progress bar) for a run in memory.
+    A run that may be the answer (``previous``, the run before it, given; or its ``plan``,
+    a resumed one) is written into ``folder`` (a :class:`~femehl.output.run.RunFolder`,
+    if any) as it goes, and always finishes; the others run in memory, and one still going at ``deadline``
+    (``time.perf_counter()``) raises :class:`_OutOfTime`.  ``progress(desc, t_end,
+    t_start)``, when given, makes a State handler with a ``close()`` (a progress bar).
     """
+    from femehl.solver.adaptive import CONTROLS
+    from femehl.solver.loop import run_scene
+
     t0 = time.perf_counter()
     tol_t = time_tolerance(level)
-    disc = {**ladder.options(scene, t_end, level), **options}
-    if runner is not None and previous is not None:
-        res = runner(level=level, tol_t=tol_t, options=disc, previous=previous)
-    else:
-        from femehl.solver.adaptive import CONTROLS
-        from femehl.solver.loop import make_stepper, run_loop
-
-        handlers = [disc.pop("callback", None)]
-        controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
-        stepper = make_stepper(scene, method, **{"scheme": "bdf2", **disc})
-        bar = None
-        if progress is not None:
-            bar = progress(f"pilot level {level:.3g} ({stepper.info.get('elements', '?')} cells)", t_end)
-            handlers.append(bar)
-        on_state = _chain(handlers)
-        if deadline is not None:
-            on_state = _deadline_guard(deadline, on_state)
-        try:
-            res = run_loop(
-                stepper, t_end, None, step_tol=tol_t, store_every=store_every, on_state=on_state, **controls
-            )
-        finally:
-            if bar is not None:
-                bar.close()
+    disc = {"scheme": "bdf2", **ladder.options(scene, t_end, level), **options}
+    on_state = disc.pop("callback", None)
+    controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
+    if plan is None and previous is not None:
+        plan = _plan(tol, level, tol_t, t_end, previous)
+    sink = None if plan is None else folder
+    if sink is None and deadline is not None:
+        on_state = _deadline_guard(deadline, on_state)
+    res = run_scene(
+        scene,
+        method,
+        disc,
+        t_end,
+        None,
+        step_tol=tol_t,
+        store_every=store_every,
+        on_state=on_state,
+        sink=sink,
+        plan=plan,
+        progress=progress,
+        label=f"level {level:.3g}",
+        **controls,
+    )
     n = int(res.info["elements"]) if "elements" in res.info else int(ladder.cells(scene, t_end, level))
     res.info.update(level=level, elements=n, tol_t=tol_t, wall=time.perf_counter() - t0)
     logger.info(
@@ -477,27 +471,63 @@ def _run(
     return res
 
 
-def _chain(handlers):
-    """One State handler calling each of ``handlers`` (None entries skipped), or None."""
-    handlers = [h for h in handlers if h is not None]
-    if not handlers:
-        return None
-    if len(handlers) == 1:
-        return handlers[0]
+def _plan(tol, level, tol_t, t_fit, previous) -> dict:
+    """What a run folder records of a candidate run, to resume it (its checkpoint's ``auto``)."""
+    return {
+        "tol": tol,
+        "level": level,
+        "tol_t": tol_t,
+        "t_fit": t_fit,
+        "companion": companion_record(previous),
+    }
 
-    def each(state):
-        for h in handlers:
-            h(state)
 
-    return each
+def resume_to_tolerance(scene, folder, saved: dict, *, t_end, method, store_every, progress=None, **options):
+    """A resumed automatic run: the saved candidate (``saved``, its plan in the checkpoint)
+    goes on in ``folder`` on the mesh it was fitted with (to the run's first ``t_end``);
+    the budgets of the sequence no longer apply.  Extended past its companion's end, the
+    companion runs again; the estimate goes on from the earlier part's
+    (:meth:`~femehl.accuracy.estimate.Estimate.continued`)."""
+    t_fit = float(saved.get("t_fit", saved["companion"]["t"][-1]))
+    kept = {k: v for k, v in options.items() if k not in ("max_wall", "max_elements")}
+    res = _run(
+        scene,
+        method,
+        _fitted_to(LADDERS[method], t_fit),
+        t_end,
+        saved["level"],
+        store_every,
+        kept,
+        folder,
+        progress=progress,
+        plan=saved,
+    )
+    if res.info.get("nothing_to_do"):
+        return res
+    res.info["tol_t"] = saved["tol_t"]
+    level_c = float(saved["companion"]["level"])
+    companion = CompanionSeries(saved["companion"])
+    if t_end > companion.t[-1] * (1.0 + 1e-9):  # extended: its companion goes on too
+        folder.say(
+            f"femehl: the coarser companion (level {level_c:.3g}) again to t = {t_end:g} (the estimate)"
+        )
+        companion = companion_to(scene, method, t_end, t_fit, level_c, store_every, kept)
+    est = estimate(res, companion, level_c / saved["level"])
+    before = folder.earlier_estimate()
+    res.estimate = est.continued(before) if before else est
+    res.info["auto"] = {"tol": saved["tol"], "resumed": True}
+    return res
+
+
+def _fitted_to(ladder: Ladder, t_fit: float) -> Ladder:
+    """``ladder`` with its discretizations fitted to a run to ``t_fit`` whatever the run's end."""
+    return Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
 
 
 def companion_to(scene, method, t_end, t_fit, level, store_every, options) -> Result:
     """The companion run of a resumed automatic run again, to a later ``t_end``: ``level``'s
     discretization fitted to ``t_fit`` (the first run's end, as the candidate's mesh)."""
-    ladder = LADDERS[method]
-    fitted = Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
-    return _run(scene, method, fitted, t_end, level, 0, dict(options))
+    return _run(scene, method, _fitted_to(LADDERS[method], t_fit), t_end, level, 0, dict(options))
 
 
 def _next_level(level: float, err: float, tol: float) -> float:
@@ -630,7 +660,7 @@ def solve_to_tolerance(
     max_elements: int | None = None,
     max_wall: float | None = None,
     level: float = LEVEL0,
-    runner=None,
+    folder=None,
     on_run: Callable[[Result], None] | None = None,
     progress=None,
     **options,
@@ -650,8 +680,10 @@ def solve_to_tolerance(
     :func:`femehl.solve` (not the discretization's,
     nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run;
     ``on_run(result)`` with every finished run, pilots included (its scalars stay; its
-    fields are dropped once a finer run supersedes it); ``progress(desc, t_end)`` makes
-    a progress handler (a State callable with ``close()``) for each run in memory.
+    fields are dropped once a finer run supersedes it); ``progress(desc, t_end, t_start)``
+    makes a progress handler (a State callable with ``close()``) for each run;
+    ``folder`` (a :class:`~femehl.output.run.RunFolder`) is fed each run that may be the
+    answer (the pilots stay in memory; a finer candidate replaces the coarser one's files).
     """
     from femehl.solver.loop import _registry
 
@@ -675,6 +707,8 @@ def solve_to_tolerance(
     for key in ("dt_max", "dt", *ladder.keys):
         if key in options:
             raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
+    if folder is not None:
+        folder.say(f"femehl: automatic run to tol = {tol:g} (pilot runs in memory, then the run itself)")
 
     def in_time(lv: float) -> bool:
         """A run at ``lv`` is predicted to finish before the deadline (always without one)."""
@@ -734,10 +768,11 @@ def solve_to_tolerance(
                 level,
                 store_every,
                 options,
-                runner,
+                folder,
                 previous,
                 deadline,
                 progress,
+                tol,
             )
         except _OutOfTime as exc:
             stopped = "time budget"
@@ -765,8 +800,8 @@ def solve_to_tolerance(
         if runs:
             ratio = runs[-1].info["level"] / level
             est = estimate(res, runs[-1], ratio)
-            err = _worst(est)
-            logger.info("auto: estimated error %.3g (%s), level ratio %.3g", err, _where(est), ratio)
+            err = est.worst()
+            logger.info("auto: estimated error %.3g (%s), level ratio %.3g", err, est.where(), ratio)
         if fine is not None:
             fine._stored.clear()  # superseded: its scalars stay (the companion), its fields go
         fine = res
@@ -837,7 +872,7 @@ def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -
         "wall": [r.info["wall"] for r in runs],
     }
     if est is not None:
-        info.update({part: _worst(est, part) for part in ("total", "space", "time")})
+        info.update({part: est.worst(part) for part in ("total", "space", "time")})
     res.info["auto"] = info
     if not reached:
         worst = "unknown (one level only)" if est is None else f"{info['total']:.3g}"

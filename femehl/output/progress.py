@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["TimeBar"]
+__all__ = ["TimeBar", "time_bar"]
 
 FORMAT = "{desc}: {percentage:3.0f}%|{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}{postfix}]"
 
@@ -28,3 +28,8 @@ class TimeBar:
 
     def close(self) -> None:
         self.bar.close()
+
+
+def time_bar(desc: str, t_end: float, t_start: float = 0.0) -> TimeBar:
+    """A :class:`TimeBar` named ``femehl <desc>`` (the ``progress`` of :func:`femehl.solve`)."""
+    return TimeBar(f"femehl {desc}", t_end, t_start)

@@ -11,11 +11,15 @@ from __future__ import annotations
 
 import pathlib
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from femehl.errors import SceneError
 from femehl.solver.stepping import State
+
+if TYPE_CHECKING:
+    from femehl.accuracy.estimate import Estimate
 
 __all__ = ["Result"]
 
@@ -51,7 +55,7 @@ class Result:
     #: error estimate (:mod:`femehl.accuracy.auto`; None for a fixed-step expert run):
     #: ``{"t": times, name: {"space": ..., "time": ..., "total": ...}}``, relative errors;
     #: an expert run with adaptive steps has the time part only (``space``, ``total`` None)
-    estimate: dict | None = None
+    estimate: Estimate | None = None
 
     def __post_init__(self):
         from femehl.output.table import extra_columns
@@ -261,24 +265,12 @@ class Result:
         options) has all three parts; an expert run with adaptive steps (``tol`` and a
         mesh) only the time part, its ``space`` and ``total`` are None.
         """
-        est = self.estimate
-        if est is None:
+        if self.estimate is None:
             raise SceneError(
                 "this result carries no error estimate: run femehl.solve without dt= and mesh "
                 "options (automatic, to tol), or give tol= for the time part."
             )
-        if name not in est or name == "t":
-            names = [k for k in est if k != "t"]
-            raise SceneError(f"no error estimate for {name!r}: uncertainty takes one of {names}.")
-        ts = np.asarray(est["t"], dtype=float)
-        t = float(t)
-        tol = 1e-9 * max(1.0, abs(ts[-1]))
-        if not np.isfinite(t) or t < ts[0] - tol or t > ts[-1] + tol:
-            raise SceneError(f"t = {t} is outside the run [{ts[0]:g}, {ts[-1]:g}].")
-        return {
-            k: None if est[name][k] is None else float(np.interp(t, ts, est[name][k]))
-            for k in ("total", "space", "time")
-        }
+        return self.estimate.at(name, t)
 
     def save(self, folder, *, overwrite: bool = False) -> pathlib.Path:
         """Write the summary CSV, the field series and the PNGs to ``folder``.

@@ -129,10 +129,10 @@ ERROR_COLUMNS = tuple(c for q in ERROR_QUANTITIES for c in (f"err_{q}", f"err_{q
 EARLIER_ESTIMATE = "summary_estimate_before_resume.csv"
 
 
-def add_error_columns(path, estimate: dict) -> pathlib.Path:
+def add_error_columns(path, estimate) -> pathlib.Path:
     """Rewrite the summary CSV at ``path`` with :data:`ERROR_COLUMNS` from ``estimate``.
 
-    ``estimate`` is a Result's (``{"t": ..., name: {"total", "space", "time"}}``); rows
+    ``estimate`` is a Result's (:class:`~femehl.accuracy.estimate.Estimate`); rows
     at times before its span (a resumed run's earlier part) keep the estimate they had
     (:data:`EARLIER_ESTIMATE`, saved when the run was resumed), else get empty cells.
     The new file replaces the old one atomically.
@@ -146,7 +146,7 @@ def add_error_columns(path, estimate: dict) -> pathlib.Path:
         return path
     header = [c for c in rows[0] if c not in ERROR_COLUMNS]
     keep = [i for i, c in enumerate(rows[0]) if c not in ERROR_COLUMNS]
-    ts = np.asarray(estimate["t"], dtype=float)
+    ts = np.asarray(estimate.t, dtype=float)
     span = 1e-9 * max(1.0, abs(ts[-1]))
 
     def cells(t):

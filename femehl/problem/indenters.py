@@ -14,7 +14,7 @@ All lengths are in the paper's normalized units (in-plane lengths in units of
 the normalizing radius ``R*``; docs/design.md, section 2), so ``Sphere(1.0)`` is the
 paper's sphere.  :data:`INDENTERS` maps the scene-file names to the classes;
 :func:`si_indenter` builds an indenter from SI values for a
-:class:`~femehl.problem.scene.Dimensional` experiment.
+:class:`~femehl.Dimensional` experiment.
 
 Shapes
 ------
@@ -485,7 +485,7 @@ def si_indenter(kind: str, params: dict, dim) -> object:
         A key of :data:`INDENTERS` with SI support (sphere, ellipsoid, flat_punch).
     params : dict
         The indenter's parameters in metres.
-    dim : femehl.problem.scene.Dimensional
+    dim : femehl.Dimensional
         The experiment whose scales normalize them.
 
     Returns

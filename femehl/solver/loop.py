@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import time
 from collections.abc import Callable
 
 from femehl.errors import SceneError, SolverError
@@ -17,7 +18,7 @@ from femehl.problem.scene import Scene
 from femehl.solver.stepping import State, march
 from femehl.solver.threads import one_blas_thread
 
-__all__ = ["make_stepper", "methods", "run_loop"]
+__all__ = ["make_stepper", "methods", "run_loop", "run_scene"]
 
 
 def _registry():
@@ -132,3 +133,82 @@ def run_loop(
                 dt_largest=max(dts, default=math.nan),
             )
     return result
+
+
+def run_scene(
+    scene,
+    method,
+    options: dict,
+    t_end: float,
+    dt: float | None = None,
+    *,
+    step_tol: float | None = None,
+    store_every: int = 1,
+    on_state: Callable[[State], None] | None = None,
+    sink=None,
+    plan: dict | None = None,
+    progress: Callable | None = None,
+    label: str = "",
+    **controls,
+) -> Result:
+    """One run of one discretization: :func:`make_stepper` then :func:`run_loop`.
+
+    The expert mode and every run of the automatic sequence come here.  ``sink`` (a
+    :class:`femehl.output.run.RunFolder`, or None: in memory) is attached to the loop:
+    ``sink.writer(stepper, t_end, dt, step_tol, plan, t0)`` is a context manager whose
+    value is fed every State and gives ``start`` (a checkpoint to resume from, or None)
+    and ``done`` (a Result when there is nothing left to run).  ``progress(desc, t_end,
+    t_start)`` makes a progress handler with ``close()``.
+    """
+    t0 = time.perf_counter()
+    stepper = make_stepper(scene, method, **options)
+    if sink is None:
+        return _march(stepper, t_end, dt, None, step_tol, store_every, on_state, progress, label, controls)
+    with sink.writer(stepper, t_end, dt, step_tol, plan, t0) as writer:
+        if writer.done is not None:
+            return writer.done
+        handler = chain([writer, on_state])
+        result = _march(
+            stepper, t_end, dt, writer.start, step_tol, store_every, handler, progress, label, controls
+        )
+        return writer.finished(result)
+
+
+def _march(stepper, t_end, dt, start, step_tol, store_every, on_state, progress, label, controls) -> Result:
+    """:func:`run_loop` with a progress handler when ``progress`` makes one."""
+    bar = None
+    if progress is not None:
+        cells = stepper.info.get("elements", "?") if hasattr(stepper, "info") else "?"
+        what = f"{label}, " if label else ""
+        bar = progress(
+            f"{stepper.method} ({what}{cells} cells)", t_end, 0.0 if start is None else float(start.t)
+        )
+    try:
+        return run_loop(
+            stepper,
+            t_end,
+            dt,
+            step_tol=step_tol,
+            start=start,
+            store_every=store_every,
+            on_state=chain([on_state, bar]),
+            **controls,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def chain(handlers):
+    """One State handler calling each of ``handlers`` (None entries skipped), or None."""
+    handlers = [h for h in handlers if h is not None]
+    if not handlers:
+        return None
+    if len(handlers) == 1:
+        return handlers[0]
+
+    def each(state):
+        for h in handlers:
+            h(state)
+
+    return each

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.scene import Constant, Dimensional, Domain, Fluid, Motion, Scene, Sphere
 
 R, G, ETA = 2e-3, 1.0e4, 0.05  # m, Pa, Pa s

@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 import femehl
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.presets import paper_sphere
 from femehl.problem.scene import Constant, Motion, Table, TanhStart
 

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.indenters import Shape
 from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 

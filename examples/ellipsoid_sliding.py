@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import time
 
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.indenters import Ellipsoid
 from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 

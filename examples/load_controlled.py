@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, Scene, Sphere
 
 HERTZ_LOAD = 4.0 / (3.0 * math.pi)  # normalized load of the Hertz contact at hc = -1

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 import femehl
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 from femehl.problem.scene import Dimensional, Domain, Motion, Scene, Sphere, Table, TanhStart
 
 R, G_INF, G0, TAU = 0.01, 1.0e5, 1.0e6, 0.01  # m, Pa, Pa, s

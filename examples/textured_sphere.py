@@ -31,8 +31,8 @@ import time
 
 import numpy as np
 
+from femehl.api import run_to_folder
 from femehl.discretize.mesh import estimate_elements, sized_disk
-from femehl.output.run import run_to_folder
 from femehl.problem.indenters import Shape
 from femehl.problem.scene import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, TanhStart
 

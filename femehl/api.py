@@ -18,7 +18,7 @@ from femehl.solver.loop import _registry, make_stepper, methods, run_loop
 from femehl.solver.stepping import State, march
 from femehl.solver.threads import one_blas_thread
 
-__all__ = ["make_stepper", "steps", "solve", "solve_line", "run_loop", "methods"]
+__all__ = ["make_stepper", "steps", "solve", "solve_line", "run_loop", "run_to_folder", "methods"]
 
 
 @one_blas_thread
@@ -315,3 +315,11 @@ def solve_line(
     return solve(
         scene, method="line", t_end=t_end, dt=dt, store_every=store_every, callback=callback, **options
     )
+
+
+def run_to_folder(scene, folder, *, store_every=10, **options) -> Result:
+    """``solve(scene, out=folder, store_every=10, ...)``: solve ``scene`` and write
+    ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs (see :func:`solve` for the
+    options, ``out=`` for the folder's: ``overwrite``, ``resume``, ``progress``,
+    ``checkpoint_every``, ``log``)."""
+    return solve(scene, out=folder, store_every=store_every, **options)

@@ -177,6 +177,7 @@ def _method_options(run: dict, method: str, from_cli: bool) -> dict:
 
 
 def _run(args, argv=()):
+    from femehl.api import run_to_folder
     from femehl.output._validation import (
         METHOD_FLAGS,
         check_divisions,
@@ -184,7 +185,6 @@ def _run(args, argv=()):
         check_resume_overwrite,
         check_step,
     )
-    from femehl.output.run import run_to_folder
     from femehl.problem import presets
     from femehl.problem.scenefile import load_scene_file, run_options
 

@@ -265,7 +265,7 @@ def test_cli_default_is_automatic(tmp_path, capsys):
 
 def test_automatic_run_resumes(tmp_path):
     """A finished automatic run continued to a later t_end: same level, estimate rebuilt."""
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     scene = LineScene()
     out = tmp_path / "run"

@@ -102,7 +102,7 @@ def test_paper_case_with_cavitation():
 
 
 def test_resume_keeps_the_cavitated_set(tmp_path):
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     sc = LineScene(
         k=1e9, beta=BETA, motion=Motion(gap=Constant(HC), velocity=Constant(V)), L=L, cavitation="reynolds"
@@ -280,7 +280,7 @@ def test_summary_columns_series_and_restart(tmp_path):
     """summary.csv: full Sommerfeld keeps exactly its columns; a condition adds its own
     (the Result's arrays); the half-Sommerfeld series is labelled; a resumed run writes
     the same table as the whole run."""
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
     from femehl.output.series import field_value
     from femehl.output.table import COLUMNS, read_summary
 

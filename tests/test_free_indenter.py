@@ -93,7 +93,7 @@ def test_a_small_mass_is_the_imposed_load():
 def test_resume_continues_the_motion(tmp_path):
     """A run resumed from its checkpoint goes on as if never stopped (velocity and its
     history restored)."""
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     sc = Scene(
         substrate=Rigid(),

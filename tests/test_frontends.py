@@ -42,7 +42,7 @@ RUN_TOML = '[run]\nt_end = 0.1\ndt = 0.05\nmesh = "coarse"\nstore_every = 2\n'
 def run_folder(tmp_path_factory):
     """The paper case on the coarse mesh to t = 0.8, fields stored at 0, 0.2, ..., 0.8."""
     folder = tmp_path_factory.mktemp("run")
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     run_to_folder(
         femehl.presets.paper_sphere(),

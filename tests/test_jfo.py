@@ -178,7 +178,7 @@ def test_imposed_load_is_met():
 
 
 def test_resume_series_and_columns(tmp_path):
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
     from femehl.output.table import COLUMNS, read_summary
 
     sc = _TwoConstrictions(

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import femehl
+from femehl.api import run_to_folder
 from femehl.cli import main
 from femehl.output import COLUMNS
-from femehl.output.run import run_to_folder
 
 
 def _sources(points, n):

@@ -22,9 +22,9 @@ from hypothesis import strategies as st
 import femehl
 import femehl.output.run
 import femehl.solver.loop
+from femehl.api import run_to_folder
 from femehl.errors import CheckpointError, OutputError, SceneError
 from femehl.output import checkpoint, write_all
-from femehl.output.run import run_to_folder
 from femehl.output.series import scan_series
 
 SC = femehl.presets.paper_sphere()

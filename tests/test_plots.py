@@ -237,7 +237,7 @@ def test_cli_plot_bad_input(run, tmp_path, capsys, argv, words):
 
 
 def test_maps_of_a_run_without_series(tmp_path):
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     sc = femehl.presets.paper_sphere()
 
@@ -248,7 +248,7 @@ def test_maps_of_a_run_without_series(tmp_path):
 
 def test_line_contact_history_and_no_maps(tmp_path):
     """A line-contact run draws its history; maps of a 1-D run are refused, naming why."""
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
     from femehl.problem.scenefile import load_scene_file
 
     scene, _ = load_scene_file(pathlib.Path(__file__).parents[1] / "examples" / "cylinder_winkler.toml")

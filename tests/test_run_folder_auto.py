@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import femehl
+from femehl.api import run_to_folder
 from femehl.errors import OutputError
-from femehl.output.run import run_to_folder
 from femehl.output.table import ERROR_COLUMNS, read_summary
 
 SCENE = femehl.presets.paper_sphere()

@@ -22,10 +22,9 @@ import scipy.sparse as sp
 from scipy.integrate import solve_ivp
 
 import femehl
-from femehl.api import make_stepper
+from femehl.api import make_stepper, run_to_folder
 from femehl.cli import main as cli_main
 from femehl.errors import SceneError, SceneFileError
-from femehl.output.run import run_to_folder
 from femehl.problem.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape, Sphere, si_indenter
 from femehl.problem.scene import (
     Constant,

@@ -7,7 +7,7 @@ import csv
 import json
 
 import femehl
-from femehl.output.run import run_to_folder
+from femehl.api import run_to_folder
 
 SC = femehl.presets.paper_sphere()
 

@@ -30,6 +30,7 @@ import pytest
 
 import femehl
 from femehl import presets
+from femehl.api import run_to_folder
 from femehl.errors import (
     CheckpointError,
     FilmRuptureError,
@@ -39,7 +40,6 @@ from femehl.errors import (
     SolverError,
 )
 from femehl.output.checkpoint import load_checkpoint
-from femehl.output.run import run_to_folder
 from femehl.problem.scene import Domain, Fluid, Motion, RampHold, Rigid, Scene, Sphere
 from femehl.reference.baseline import RelaxationStepper, mass_balance_residual
 from femehl.solver.stepping import march

@@ -148,7 +148,7 @@ def test_steady_sliding_energy_balance():
 
 
 def test_resume_continues_the_memory(tmp_path):
-    from femehl.output.run import run_to_folder
+    from femehl.api import run_to_folder
 
     sc = dataclasses.replace(paper_sphere(), substrate=SLS)
     opts = dict(mesh="coarse", dt=0.04, scheme="bdf2", linear_solver="lu", log=lambda *a: None)

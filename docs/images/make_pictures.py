@@ -19,8 +19,8 @@ import time
 from pathlib import Path
 
 import femehl
+from femehl.api import run_to_folder
 from femehl.output import plots
-from femehl.output.run import run_to_folder
 
 HERE = Path(__file__).resolve().parent
 

@@ -8,7 +8,7 @@ element and node counts, a hash of the node coordinates; FD: dr, dtheta and
 grid size).  Both are written atomically (temporary file + rename), so a
 run killed at any moment leaves the previous checkpoint intact.
 
-:func:`femehl.output.run.run_to_folder` writes a checkpoint every
+:func:`femehl.api.run_to_folder` writes a checkpoint every
 ``checkpoint_every`` steps and at the end of the run (also when it stops on a
 :class:`~femehl.errors.SolverError`: then it holds the last good state), and
 ``run_to_folder(..., resume=True)`` continues from it after

@@ -29,7 +29,7 @@ from femehl.output._validation import check_resume_overwrite, check_run_options
 from femehl.output.folder import check_folder, prepare_folder
 from femehl.output.result import Result
 
-__all__ = ["run_to_folder", "RunFolder"]
+__all__ = ["RunFolder"]
 
 logger = logging.getLogger("femehl")
 
@@ -96,16 +96,6 @@ def _redraw_history(folder: pathlib.Path) -> None:
         plot_history(folder)
     except Exception as exc:  # noqa: BLE001 - pictures are a convenience
         logger.warning("femehl: could not redraw %s/history.png (%s: %s)", folder, type(exc).__name__, exc)
-
-
-def run_to_folder(scene, folder, *, store_every=10, **options) -> Result:
-    """``femehl.solve(scene, out=folder, store_every=10, ...)``: solve ``scene`` and write
-    ``folder/summary.csv``, ``fields.pvd`` + ``.vtu``, PNGs (see :func:`femehl.solve`
-    for the options, ``out=`` for the folder's: ``overwrite``, ``resume``, ``progress``,
-    ``checkpoint_every``, ``log``)."""
-    from femehl.api import solve
-
-    return solve(scene, out=folder, store_every=store_every, **options)
 
 
 class RunFolder:

@@ -4,7 +4,7 @@ A *sweep* is a base scene (a TOML scene file, its content as a dict, a
 :class:`~femehl.problem.scene.Scene`, or the built-in paper case), a set of parameter values
 (a full grid, a list of cases, or a random sample) over dotted scene fields, and the
 run options (``tol``, ``t_end``, ``method``, ...).  Each case is a plain femehl run
-(:func:`femehl.output.run.run_to_folder`) in its own folder ``OUT/cases/<key>``, ``key`` the
+(:func:`femehl.api.run_to_folder`) in its own folder ``OUT/cases/<key>``, ``key`` the
 content hash of the case's scene and options (:func:`case_key`), so
 
 * re-running a sweep skips every case already finished (its ``case.json`` is there),
@@ -350,7 +350,7 @@ RUN_OPTIONS = ("method", "t_end", "dt", "store_every", "checkpoint_every", "tol"
 
 
 def check_case_options(scene, options: dict) -> dict:
-    """Refuse, before anything runs, run options :func:`femehl.output.run.run_to_folder` would refuse.
+    """Refuse, before anything runs, run options :func:`femehl.api.run_to_folder` would refuse.
 
     The same checks as the run makes before it writes anything (the method and the scene,
     ``t_end``/``dt``/``store_every``/``checkpoint_every``, ``tol``, ``max_wall``, the
@@ -679,8 +679,8 @@ def run_case(case: Case, folder) -> dict:
     returned as it is (a rescheduled task does not run twice).
     """
     from femehl import __version__
+    from femehl.api import run_to_folder
     from femehl.output.checkpoint import describe
-    from femehl.output.run import run_to_folder
 
     folder = pathlib.Path(folder)
     done = read_case(folder)

@@ -1,8 +1,9 @@
 """A run folder: summary CSV, field series, checkpoint and PNGs written as the run goes.
 
 :class:`RunFolder` is attached to the one loop (:func:`femehl.solver.loop.run_scene`) by
-:func:`femehl.solve` ``(..., out=folder)``; :func:`run_to_folder` is that call with
-``store_every=10``, and ``femehl run`` and sweeps use it (docs/design.md section 8).
+:func:`femehl.solve` ``(..., out=folder)``; ``run_to_folder`` is that call with
+``store_every=10`` (:func:`femehl.api.run_to_folder`), which ``femehl run`` and sweeps use
+(docs/design.md section 8).
 Every option and the folder are checked before anything in the folder is touched: a
 folder that already holds a run is refused unless ``overwrite`` (its femehl files are
 replaced; other files stay) or ``resume`` (it is continued from its checkpoint).

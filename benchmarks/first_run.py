@@ -34,8 +34,9 @@ def run(env_extra: dict, src: str | None = None) -> float:
         env["PYTHONPATH"] = src
     out = pathlib.Path(tempfile.mkdtemp(prefix="femehl-first-run-"))
     t0 = time.perf_counter()
-    subprocess.run(
+    subprocess.run(  # from the scratch folder: a checkout in the working directory would shadow SRC
         [sys.executable, "-m", "femehl.cli", "run", "--quiet", "--out", str(out / "run")],
+        cwd=out,
         env=env,
         check=True,
         stdout=subprocess.DEVNULL,
@@ -74,7 +75,7 @@ def main(argv=None):
         "| --- | --- | --- | --- |",
         *(f"| {i + 1} | {a:.1f} | {b:.1f} | {a / b:.3f} |" for i, (a, b) in enumerate(rows)),
         *(
-            f"| before ({args.before}), {i + 1} | {a:.1f} | {b:.1f} | {a / b:.3f} |"
+            f"| before ({os.path.basename(args.before)}), {i + 1} | {a:.1f} | {b:.1f} | {a / b:.3f} |"
             for i, (a, b) in enumerate(before)
         ),
         "",

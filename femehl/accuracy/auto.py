@@ -1,80 +1,14 @@
 """Any scene to a requested accuracy, with an error estimate: :func:`solve_to_tolerance`.
 
-``femehl.solve(scene, t_end=..., tol=1e-2)`` (and ``femehl run``) end up here when the
-caller gives neither ``dt`` nor a discretization option (``mesh=``, ``n_elements=``...).
-
-What ``tol`` means
-------------------
-The load, the central film and the minimum film (the true minimum over film points,
-origin and nodes, :mod:`femehl.solver.stepper`) at every step of the returned run are
-within ``tol`` relative (the load relative to ``max(|load|, 0.1)``: a load growing from 0
-has no relative error at t = 0): the estimate below is at most ``ACCEPT * tol`` = 0.75
-tol, a margin for the estimate running up to a quarter below the true error.  The fields
-are not estimated separately: the film and pressure errors in the max norm over the film
-points are what the time controller bounds per step, and the mesh is the one whose
-headline errors pass.
-
-One number refines everything: the level
-----------------------------------------
-A method is automatic when it has a :class:`Ladder` in :data:`LADDERS`: a map from a
-``level`` (element sizes proportional to it) to its discretization options.  FE
-(``"fe"``) uses the scene-fitted gmsh mesh :func:`femehl.discretize.fitted.fitted_disk` (level 1:
-the ``medium`` ladder rung's sizes for the paper sphere), line contact (``"line"``)
-``n_elements = 400 / level``.  FD has none (it is the cross-check of FE, run by hand).
-Every run at ``level`` takes adaptive BDF2 steps (:mod:`femehl.solver.adaptive`) at the
-time tolerance ``tol_t = TAU1 * level**2`` (:func:`time_tolerance`), so that its space
-error (order 2 in h) and its time error (proportional to ``tol_t``) both scale like
-``level**2``: one ratio ``r`` between two levels divides the whole error by ``r**2``.
-
-The sequence
-------------
-Levels 4, 2 (pilots: cheap, their fields never written), then each next level aims at
-an estimated error of ``SAFETY * tol`` = 0.6 tol from the last pair's estimate,
-``level / r`` with ``r = sqrt(err / (0.6 tol))`` kept in ``[sqrt 2, 2]``; a run is
-accepted when it is at least the third and its estimate is <= ``ACCEPT * tol`` = 0.75
-tol (:data:`ACCEPT`: the margin for the estimate's measured shortfall).  A level whose cells
-would exceed ``max_elements`` (:func:`cell_budget`: 100,000 on a substrate with the fast
-hierarchical operator or with sparse operators only, a cost budget a caller may raise;
-25,000 on one whose operator is dense only, a layer, where the dense influence matrix
-of about 3 GB is the limit) is not run.  Instead the finest level within the budget is
-run, if it is at least :data:`BUDGET_RATIO` = 1.2 times finer than the last run
-(:func:`budget_level`), and the sequence stops there: when it does not reach ``tol``
-(or no such level exists) the last run is returned with ``info["auto"]["reached"] =
-False`` and a logging warning.  A time budget ``max_wall`` (seconds, default none) works the same way on the
-predicted wall time of each next run (:func:`predicted_wall`: the last run's cost per
-step times the cells ratio to the power fitted on the last two runs, times ``r`` times
-its steps): a level predicted to overrun what is left is not started, the finest level
-predicted to fit is run instead if it is at least BUDGET_RATIO finer; then the next level
-is predicted again from the runs so far (a run cheaper than predicted leaves time for
-another), and the sequence stops, with ``info["auto"]["stopped"] = "time budget"``, when
-no level BUDGET_RATIO finer than the last run is predicted to fit.  A run held in memory
-(every run of :func:`femehl.solve`, the pilots of ``femehl run``) that is still going at
-the deadline is abandoned and the last finished run returned; a candidate streaming into
-a run folder always finishes (its files replace the previous candidate's).  When no run
-finished in time, :class:`~femehl.errors.TimeBudgetError`.  The companion of the
-returned run costs ``r**-4`` or less of it on the dense operator (cells ``r**2``
-fewer, each step ``r**4``), so the estimate costs about 6 to 25 % more than the run
-itself; the pilots less than that.
-
-Estimators (relative, one array per quantity on the returned run's ``t``)
---------------------------------------------------------------------------
-* **total** (Richardson, :func:`pair_error`): with ``q_f`` the returned run and ``q_c``
-  the previous one (``r`` times its level, interpolated to ``q_f``'s times),
-  ``|q_f - q_c| / (r**2 - 1)``, then its running maximum over the steps so far (the
-  difference changes sign in time, the error does not vanish where it does).
-* **time**: the accumulated local errors of the returned run's controller,
-  ``sum error_estimate * max(dt, 0.01)`` (:func:`time_error`), at most ``total``;
-  **space** = total - time.  An expert run with adaptive steps (``tol`` and a mesh) gets
-  the time part only.
-
-Why TAU1 = 1.25e-3: with larger time tolerances the time part dominates the pair, and
-the BDF2 global error follows ``tol_t`` less exactly than the space error follows h^2;
-at 5e-3 and 2.5e-3 the estimate fell below half the true error at 14-18 % of the steps
-on line contact at tol = 1e-3 and on the paper sphere at tol = 3e-2
-(tests/test_auto.py), at 1.25e-3 at under 10 %.
-
-Measured (tests/test_auto.py, benchmarks/auto_results.md): line contact and the paper
-sphere are within tol with the estimate >= half the true error at >= 90 % of the steps.
+``femehl.solve(scene, t_end=..., tol=1e-2)`` (and ``femehl run``) come here when the caller
+gives neither ``dt`` nor a discretization option.  The load, the central film and the
+minimum film of the returned run are within ``tol`` relative at every step: its
+:class:`~femehl.accuracy.estimate.Estimate` is at most :data:`ACCEPT` * ``tol``.  How:
+one number, the level, refines mesh and time steps together (:class:`Ladder`, time
+tolerance ``TAU1 * level**2``); pilots at levels 4 and 2, then each level aimed at
+``SAFETY * tol`` from the last pair's Richardson estimate, within the cell and time
+budgets.  The sequence, the estimators, the budgets and the measurements behind every
+constant: docs/design.md section 9.
 """
 
 from __future__ import annotations
@@ -668,7 +602,7 @@ def solve_to_tolerance(
     """Run ``scene`` to ``t_end`` with the load and films to about ``tol`` relative.
 
     Returns the finest run (a :class:`~femehl.output.result.Result`) with ``result.estimate``
-    (see the module docstring for the estimators) and ``result.info["auto"]``: ``tol``,
+    (docs/design.md section 9 for the estimators) and ``result.info["auto"]``: ``tol``,
     ``reached`` (the estimate is <= :data:`ACCEPT` * ``tol``), ``accept``, ``stopped``
     (None, ``"cell budget"`` or ``"time budget"``: what ended a sequence that did not
     reach ``tol``), ``levels``, ``elements``, ``steps``,
@@ -676,7 +610,7 @@ def solve_to_tolerance(
     ``total``, ``space`` and ``time`` errors.  ``level`` is the first (coarsest) level;
     ``max_elements`` the cell budget (default: :func:`cell_budget` of the scene's
     substrate); ``max_wall`` a time budget in seconds for the whole sequence (default:
-    none; see the module docstring); ``options`` go to
+    none; see docs/design.md section 9); ``options`` go to
     :func:`femehl.solve` (not the discretization's,
     nor ``tol``, ``dt_max``); a ``callback`` is called with the states of every run;
     ``on_run(result)`` with every finished run, pilots included (its scalars stay; its

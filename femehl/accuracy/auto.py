@@ -25,6 +25,7 @@ import numpy as np
 from femehl.accuracy.estimate import Estimate
 from femehl.errors import SceneError, SolverError, TimeBudgetError
 from femehl.output.result import Result
+from femehl.registry import Registry
 from femehl.solver.adaptive import LOAD_FLOOR, UNIT_STEP, breakpoints_of
 
 __all__ = [
@@ -126,15 +127,14 @@ class Ladder:
 
 
 #: method name -> its :class:`Ladder`
-LADDERS: dict[str, Ladder] = {}
+LADDERS = Registry("ladder")
 
 
 def register_ladder(method: str, ladder: Ladder) -> Ladder:
     """Make ``method`` automatic: :func:`solve_to_tolerance` refines it along ``ladder``."""
     if not isinstance(ladder, Ladder):
         raise SceneError(f"register_ladder: give a femehl.auto.Ladder, got {type(ladder).__name__}.")
-    LADDERS[method] = ladder
-    return ladder
+    return LADDERS.register(method)(ladder)
 
 
 def _fe_options(scene, t_end, level):

@@ -300,20 +300,17 @@ def _dry_contact(substrate, shape: SampledShape) -> DryContact:
     )
 
 
-def indentation(scene, *, load: float | None = None, depth: float | None = None):
+def indentation(scene, *, load: float | None = None, depth: float | None = None, shape=None):
     """``(ax, ay, delta)``: the dry contact's semi-axes and depth under ``load`` (the
-    substrate's :meth:`dry_contact` inverted) or at ``depth``; zeros when it does not touch."""
+    substrate's :meth:`dry_contact` inverted) or at ``depth``; zeros when it does not touch.
+    ``shape``: the scene's :func:`sample_shape`, if the caller has it already."""
+    if (depth if load is None else load) is None or (depth if load is None else load) <= 0.0:
+        return 0.0, 0.0, 0.0
+    dry = _dry_contact(scene.substrate, sample_shape(scene) if shape is None else shape)
     if load is not None:
-        if load <= 0.0:
-            return 0.0, 0.0, 0.0
-        dry = _dry_contact(scene.substrate, sample_shape(scene))
         if dry.load is None:
             return 0.0, 0.0, 0.0
         depth = dry.depth(load)
-    elif depth is None or depth <= 0.0:
-        return 0.0, 0.0, 0.0
-    else:
-        dry = _dry_contact(scene.substrate, sample_shape(scene))
     ax, ay = dry.axes(depth)
     return float(ax), float(ay), float(depth)
 

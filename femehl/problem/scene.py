@@ -542,6 +542,7 @@ class Scene:
 
         from femehl.elastic.contact import indentation, sample_shape
 
+        shape = None
         times = self._check_times()
         if self.motion.load_controlled:
             Fs = []
@@ -562,7 +563,8 @@ class Scene:
                     raise SceneError(_negative_load_message(Ft, t))
                 Fs.append(Ft)
             F = max(Fs, default=0.0)
-            depth = indentation(self, load=F)[2]
+            shape = sample_shape(self) if F > 0.0 else None  # sampled once: depth and overlap
+            depth = indentation(self, load=F, shape=shape)[2]
             what = (
                 f"the largest imposed load |F| = {F:g} (sampled over t in [0, {times[-1]:g}]) "
                 f"presses the indenter about {depth:.3g} deep (dry-contact estimate)"
@@ -577,7 +579,7 @@ class Scene:
             hmin = min(hs, default=hc0)
             depth = -hmin
             what = f"an indentation hc = {hmin:g}"
-        a = sample_shape(self).overlap_radius(depth) if depth > 0.0 else 0.0
+        a = (shape or sample_shape(self)).overlap_radius(depth) if depth > 0.0 else 0.0
         need = CONTACT_MARGIN * a
         if L < need * (1.0 - 1e-9):  # the depth's bisection lands within 1e-15 above it
             raise SceneError(

@@ -234,9 +234,6 @@ class LineShape:
         """``(a, 0)``: the overlap ``x^2/(2R) < depth`` is ``|x| < a = sqrt(2 R depth)``."""
         return math.sqrt(2.0 * self.R * max(depth, 0.0)), 0.0
 
-    def overlap_radius(self, depth: float) -> float:
-        return self.overlap_axes(depth)[0]
-
     def overlap_volume(self, depth: float) -> float:
         """``int (depth - x^2/(2R))+ dx = (2/3) a^3 / R``."""
         a = self.overlap_axes(depth)[0]

@@ -79,10 +79,11 @@ def test_nothing_written_before_is_lost(made, tmp_path_factory, kind, damage, ac
         assert after == before
         return
     rows = read_summary(folder / "summary.csv")
-    if action == "overwrite":  # a fresh run of the same scene: the same answer (to the
-        # linear solver's tolerance: its recycled Krylov space is the process's)
+    if action == "overwrite":  # a fresh run of the same scene: the same answer to the
+        # iterative linear solver's tolerance (two identical runs differ by up to 3.6e-5 in
+        # the load: the recycled Krylov space is the process's); a different run would not
         assert rows["t"][-1] == pytest.approx(0.2)
-        assert rows["load"][-1] == pytest.approx(rows_before["load"][-1], rel=1e-6)
+        assert rows["load"][-1] == pytest.approx(rows_before["load"][-1], rel=1e-4)
         return
     # resumed to a later time: the rows written before are kept, the new ones follow
     n = rows_before["t"].size

@@ -20,8 +20,8 @@ import femehl
 from femehl.api import make_stepper, run_loop, solve
 from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
 from femehl.problem.line import LineScene
-from femehl.solver.adaptive import StepController, march_adaptive
-from femehl.solver.stepping import SCHEMES, State, film_positive
+from femehl.solver.adaptive import AdaptiveSteps, StepController
+from femehl.solver.stepping import SCHEMES, FixedSteps, State, film_positive, march
 
 
 # ---- a scalar ODE with a known solution ---------------------------------------------------
@@ -115,8 +115,8 @@ class Fragile(ScalarODE):
         return super().step(state, t_new, dt)
 
 
-def _run(stepper, t_end, **kw):
-    return list(march_adaptive(stepper, t_end, **kw))
+def _run(stepper, t_end, start=None, **kw):
+    return list(march(stepper, t_end, AdaptiveSteps(**kw), start=start))
 
 
 def _global_error(ode, states):
@@ -332,3 +332,32 @@ def test_film_positive_helper():
     s = ScalarODE().initial_state()
     assert film_positive(s)
     assert not film_positive(ScalarODE(y0=-1.0).initial_state())
+
+
+def test_the_one_loop_walks_any_step_policy():
+    # fixed steps given as a number and as the policy object are the same run; a policy of
+    # one's own (here: doubling steps) is walked by the same loop, one step() per trial
+    ode = ScalarODE()
+    a = [s.d[0] for s in march(ode, 1.0, 0.1)]
+    b = [s.d[0] for s in march(ScalarODE(), 1.0, FixedSteps(0.1))]
+    assert a == b and len(a) == 11
+
+    class Doubling:
+        def begin(self, stepper, t_end, start):
+            self.t_end, self.h, self.last = t_end, 0.01, stepper.initial_state()
+            return self.last
+
+        def propose(self):
+            if self.last.t >= self.t_end:
+                return None
+            h = min(self.h, self.t_end - self.last.t)
+            return self.last, self.last.t + h, h
+
+        def judge(self, trial, failure):
+            self.last, self.h = trial, 2 * self.h
+            yield trial
+
+    ode = ScalarODE()
+    ts = [s.t for s in march(ode, 1.0, Doubling())]
+    assert ts == pytest.approx([0.0, 0.01, 0.03, 0.07, 0.15, 0.31, 0.63, 1.0])
+    assert ode.solves == len(ts) - 1

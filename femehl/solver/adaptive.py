@@ -1,95 +1,11 @@
-"""Adaptive time steps for the lagged stepper: still ONE linear system per trial step.
+"""Adaptive time steps, still ONE linear system per trial step: :class:`AdaptiveSteps`, the
+step policy the one time loop (:func:`femehl.solver.stepping.march`) walks with when a step
+tolerance is given.
 
-:func:`march_adaptive` walks time like :func:`femehl.solver.stepping.march` (a generator: the
-initial state, then every accepted state) but chooses each step from a local error
-estimate.  Nothing is iterated: a trial step is one call of ``stepper.step`` (one lagged
-linear solve, no side effect on the state), and a rejected trial is simply discarded.
-
-Estimator (Milne's device)
---------------------------
-Before a step of size ``h`` from ``t_n`` the film is predicted by explicit polynomial
-extrapolation of the last accepted levels, and the local error of the step is a fixed
-multiple of the difference between the solution and that prediction:
-
-* BDF2 (order 2): quadratic predictor through ``t_{n-2}, t_{n-1}, t_n``.  With
-  ``h1 = t_n - t_{n-1}``, ``h2 = t_{n-1} - t_{n-2}``, ``omega = h/h1`` and the leading
-  BDF2 coefficient ``a0 = (1 + 2 omega)/(1 + omega)``, the variable-step local error is
-  ``y''' h^2 (h + h1) / (6 a0)`` and the predictor's ``y''' h (h + h1)(h + h1 + h2) / 6``,
-  so ``LTE ~ c (d - d_pred)`` with ``c = (h/a0) / (h/a0 + h + h1 + h2)`` (2/11 at
-  constant step).
-* backward Euler (order 1, ``scheme="euler"``): linear predictor through
-  ``t_{n-1}, t_n``, ``c = h / (2 h + h1)`` (1/3 at constant step).
-
-The coefficients of the scheme are lagged (extrapolated) too; that part of the local
-error is of the same order in ``h`` but not proportional to ``y'''``.  The estimate does
-not separate it; the tests measure the resulting global error against a fine fixed-step
-run (see ``tests/test_adaptive.py``).
-
-Norm
-----
-Relative, in the max norm over the film points, with the load as one more component,
-and per unit time::
-
-    err = c * max( max_i |d_i - d_pred_i| / d_i ,  |F - F_pred| / max(max|F|, 0.1) ) / max(h, 0.01)
-
-``d_i > 0`` is the trial film at film point i (a trial with a film <= 0 is rejected
-before), ``F`` the load and ``max|F|`` the largest load of the run so far; the floor
-``LOAD_FLOOR = 0.1`` (loads are O(0.1 .. 1) in the paper's normalization) keeps a load
-growing from 0 from having an infinite relative error at t = 0.  Dividing by ``h`` makes
-``tol`` a relative error per unit (normalized) time, so the global error follows ``tol``
-(measured: about 0.3 to 1 times tol, tests/test_adaptive.py) instead of growing with the
-number of steps.  Below ``UNIT_STEP = 0.01`` the division is by 0.01 (error per step of
-that length): an error per unit time cannot be met in the stiff initial layer of the
-film (time scale ~ 1e-6, amplitude ~ 1e-6), whose whole error is that small.
-
-Controller
-----------
-A trial is accepted when ``err <= tol``.  Either way the next step is
-``dt_new = dt * min(fac_max, max(fac_min, safety * (tol/err)^(1/q)))`` with ``q = p``
-(the order: ``err ~ h^p`` per unit time) for ``h >= UNIT_STEP`` and ``q = p + 1`` below,
-``fac_min = 0.2`` and ``fac_max = 2`` (variable-step BDF2 is zero-stable for step ratios
-below 1 + sqrt 2); no growth on the step right after a rejection, a cut by ``fac_min`` on a
-second consecutive rejection of the same step (the estimate is then not asymptotic, as
-when the contact edge sweeps over an element), and a growth factor below ``hold = 1.5``
-keeps ``dt`` (a new ``dt`` makes the gmres solver refactor its preconditioner, and a
-steady ``dt`` keeps the estimate smooth).  ``dt`` stays in ``[dt_min, dt_max]``.  When
-steady (``err -> 0``) steps grow by ``fac_max`` up to ``dt_max``.
-
-Start, breakpoints and restarts
--------------------------------
-The first step has no history: it is a backward-Euler step (the scheme's own first step)
-of size ``dt0``.  Its error ``h1^2 y''/2`` is judged after the second step, from the
-second difference of the three levels: with ``d_lin`` the linear extrapolation of
-``d0, d1`` to ``t2``, ``LTE_1 = h1^2 / (h2 (h1 + h2)) * |d2 - d_lin|`` in the norm above
-(``err_1 = LTE_1 / max(h1, UNIT_STEP)``, order p = 1 in the controller).
-The pair (Euler step, first BDF2 step) is accepted or rejected together on ``err_1``
-(the step-1 state is yielded only then), and ``err_1`` is the ``error_estimate`` of both.
-Steps never cross a breakpoint of the motion (:attr:`femehl.problem.scene.Motion.breakpoints`:
-the end of the indentation ramp, the start of sliding, table times): a step lands
-exactly on it, and since the derivatives of the solution jump there the history is
-dropped (``d_prev = None``: the next step is a backward-Euler start again) and the step
-restarts from ``min(dt, dt0)``.  A resumed run (``start``) restarts the same way.  On a
-substrate whose pressure follows the motion at once (``substrate.instant``: a rigid one,
-where p is algebraic in hc'), the load jumps at such a (re)start: that jump is no time
-error, so the load is judged from the levels after it only (the film from all of them).
-
-Failures
---------
-A trial step that raises :class:`~femehl.errors.FilmRuptureError` or
-:class:`~femehl.errors.SingularSystemError`, or whose film is <= 0 anywhere
-(:func:`femehl.solver.stepping.film_positive`: film points, origin, probed nodes), is rejected
-and retried with ``dt/4``.  Below ``dt_min`` the run stops with a FilmRuptureError that
-tells apart a film that closes (it decreased at that place over each of the last
-accepted steps, at a rate reaching zero within CLOSE_STEPS = 3 steps, or it is already
-below THIN_FILM = 1e-4 times the initial thinnest film: solid contact) from a step
-floor reached while the film was not closing.  An error estimate that stays above ``tol``
-at ``dt_min`` stops the run the same way (a :class:`~femehl.errors.SolverError` when the
-film is not closing).
-
-Every yielded State's ``info`` gets ``dt`` (the step that led to it, 0 for the first),
-``error_estimate`` (nan where none was made) and ``rejected`` (trial steps discarded since
-the previous yielded state).  Rejections are logged (logger ``"femehl"``, DEBUG), a summary
-at the end (INFO).
+The estimator (Milne's device on the film and the load), its norm, the controller, the
+start pair, breakpoints and restarts, and the failures are in docs/design.md section 3.1.
+Every yielded State's ``info`` gets ``dt``, ``error_estimate`` (nan where none was made) and
+``rejected`` (trial steps discarded since the previous yielded state).
 """
 
 from __future__ import annotations
@@ -98,16 +14,15 @@ import dataclasses
 import logging
 import math
 from collections import deque
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
+from femehl.errors import FilmRuptureError, SceneError, SolverError
 from femehl.solver.stepping import State, film_floor, film_positive
 from femehl.validation import check_positive
 
-__all__ = ["StepController", "march_adaptive", "breakpoints_of", "CONTROLS"]
+__all__ = ["AdaptiveSteps", "StepController", "breakpoints_of", "CONTROLS"]
 
 logger = logging.getLogger("femehl")
 
@@ -122,7 +37,7 @@ THIN_FILM = 1e-4
 LOAD_FLOOR = 0.1
 #: the local error is per unit time for steps longer than UNIT_STEP, per UNIT_STEP below
 UNIT_STEP = 0.01
-#: keyword arguments of :func:`march_adaptive` that tune the controller
+#: keyword arguments of :class:`AdaptiveSteps` that tune the controller
 CONTROLS = ("dt0", "dt_min", "dt_max", "safety")
 
 
@@ -174,6 +89,8 @@ class _Run:
     #: the load jumps at the (re)start ``origin`` where hc' does, which is no time error
     instant: bool = False
     origin: float = -math.inf
+    stops: list = field(default_factory=list)  # the breakpoints ahead, then t_end
+    trial: tuple = (math.nan, math.nan)  # the trial step proposed: (t_new, h)
 
 
 @dataclass(frozen=True)
@@ -219,7 +136,7 @@ def _lagrange(ts, t) -> np.ndarray:
 
 
 def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) -> float:
-    """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (see the module doc);
+    """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (docs/design.md section 3.1);
     the film alone when ``load_pred`` is None."""
     d = np.asarray(trial.d, dtype=float)
     err = float(np.max(np.abs(d - d_pred) / d)) if d.size else 0.0
@@ -280,20 +197,6 @@ def _next_h(dt: float, remaining: float) -> float:
     if remaining < 2.0 * dt:
         return 0.5 * remaining
     return dt
-
-
-def _try(stepper, base: State, t_new: float, h: float):
-    """One trial step: ``(state, None)`` or ``(None, _Failure)``."""
-    try:
-        s = stepper.step(base, t_new, h)
-    except FilmRuptureError as exc:
-        return None, _Failure(str(exc), tuple(exc.where), exc.d_min)
-    except SingularSystemError as exc:
-        return None, _Failure(f"singular step ({exc})")
-    if not film_positive(s):
-        d, at, label = film_floor(s)
-        return None, _Failure(f"film {d:.3g} <= 0", at, d, label)
-    return s, None
 
 
 def _film_track(stepper, states, where):
@@ -388,28 +291,15 @@ def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf):
     return dt0, dt_min, dt_max
 
 
-# ---- the time loop ------------------------------------------------------------------------
-def march_adaptive(
-    stepper,
-    t_end: float,
-    *,
-    tol: float,
-    dt0: float | None = None,
-    dt_min: float | None = None,
-    dt_max: float | None = None,
-    start: State | None = None,
-    safety: float = 0.9,
-) -> Iterator[State]:
-    """Yield the initial state, then every accepted state up to ``t_end`` (adaptive steps).
+# ---- the step policy ----------------------------------------------------------------------
+class AdaptiveSteps:
+    """The step policy of adaptive steps to a local error ``tol`` (for
+    :func:`femehl.solver.stepping.march`, the one time loop).
 
     Parameters
     ----------
-    stepper : LaggedStepper or any object with ``initial_state()``, ``step(state, t, dt)``
-        (and optionally ``scheme`` and ``scene`` for the order and the breakpoints).
-    t_end : float
-        End time; the last step lands on it.
     tol : float
-        Relative local error per unit time, in the norm of the module docstring (0 < tol < 1);
+        Relative local error per unit time, in the norm of docs/design.md section 3.1 (0 < tol < 1);
         the global error of load and films is then about tol or below.
     dt0 : float, optional
         First step and the step after each breakpoint; default ``0.05 tol``.
@@ -418,63 +308,171 @@ def march_adaptive(
         the default first step) and ``0.1`` times the run's span.  The ceiling is at most
         the substrate's ``step_limit`` (:func:`femehl.elastic.base.step_limit`: the
         largest step a viscoelastic memory resolves).
-    start : State, optional
-        Continue from this state (its history is dropped: the run restarts there).
     safety : float, default: 0.9
         The controller's safety factor.
+
+    The stepper is a LaggedStepper or any object with ``initial_state()``, ``step(state, t,
+    dt)`` (and optionally ``scheme`` and ``scene`` for the order and the breakpoints).  A
+    run from ``start`` drops its history: the run restarts there.
     """
-    t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
-    tol = check_positive("tol", tol, "Give a relative error per unit time, e.g. 1e-3.")
-    if tol >= 1.0:
-        raise SceneError(f"tol = {tol:g} is a relative error per unit time: use tol < 1 (e.g. 1e-3).")
-    safety = check_positive("safety", safety)
-    if safety > 1.0:
-        raise SceneError(f"safety = {safety:g} must be in (0, 1] (0.9 is usual).")
-    state = stepper.initial_state() if start is None else start
-    if t_end <= state.t:
-        raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
-    from femehl.elastic.base import step_limit
 
-    scene = getattr(stepper, "scene", None)
-    limit = step_limit(getattr(scene, "substrate", None), scene, getattr(stepper, "disc", None), t_end)
-    dt0, dt_min, dt_max = _limits(t_end - state.t, tol, dt0, dt_min, dt_max, limit)
-    eps = 1e-12 * max(1.0, abs(t_end))
-    stops = sorted(
-        {b for b in breakpoints_of(getattr(stepper, "scene", None)) if state.t + eps < b < t_end - eps}
-        | {t_end}
-    )
-    ctl = StepController(tol, safety)
-    order = _order(stepper)
+    def __init__(
+        self,
+        tol: float,
+        *,
+        dt0: float | None = None,
+        dt_min: float | None = None,
+        dt_max: float | None = None,
+        safety: float = 0.9,
+    ):
+        tol = check_positive("tol", tol, "Give a relative error per unit time, e.g. 1e-3.")
+        if tol >= 1.0:
+            raise SceneError(f"tol = {tol:g} is a relative error per unit time: use tol < 1 (e.g. 1e-3).")
+        safety = check_positive("safety", safety)
+        if safety > 1.0:
+            raise SceneError(f"safety = {safety:g} must be in (0, 1] (0.9 is usual).")
+        self.tol, self.safety = tol, safety
+        self.dt0, self.dt_min, self.dt_max = dt0, dt_min, dt_max
 
-    state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
-    run = _Run(
-        dt=dt0,
-        levels=[_restart(state)],
-        load_scale=abs(_load(state)),
-        film0=film_floor(state)[0],
-        instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
-        origin=state.t,
-    )
-    run.recent.append(state)
-    yield state
-    for stop in stops:
-        while stop - run.levels[-1].t > eps:
-            yield from _advance(stepper, run, ctl, order, stop, dt_min, dt_max)
-        if run.pending is not None:  # an Euler start step that reached the stop alone
+    def begin(self, stepper, t_end: float, start: State | None) -> State:
+        from femehl.elastic.base import step_limit
+
+        t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
+        state = stepper.initial_state() if start is None else start
+        if t_end <= state.t:
+            raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
+        scene = getattr(stepper, "scene", None)
+        limit = step_limit(getattr(scene, "substrate", None), scene, getattr(stepper, "disc", None), t_end)
+        dt0, dt_min, dt_max = _limits(t_end - state.t, self.tol, self.dt0, self.dt_min, self.dt_max, limit)
+        eps = 1e-12 * max(1.0, abs(t_end))
+        stops = sorted({b for b in breakpoints_of(scene) if state.t + eps < b < t_end - eps} | {t_end})
+        state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)
+        self._stepper, self._order = stepper, _order(stepper)
+        self._ctl = StepController(self.tol, self.safety)
+        self._dt0, self._dt_min, self._dt_max, self._eps, self._t_end = dt0, dt_min, dt_max, eps, t_end
+        self._run = _Run(
+            dt=dt0,
+            levels=[_restart(state)],
+            load_scale=abs(_load(state)),
+            film0=film_floor(state)[0],
+            instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
+            origin=state.t,
+            stops=stops,
+        )
+        self._run.recent.append(state)
+        return state
+
+    def propose(self):
+        """The next trial ``(base, t_new, h)`` toward the next stop, None when the run is done."""
+        run = self._run
+        if not run.stops:
+            logger.info(
+                "femehl: adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
+                self._t_end,
+                run.accepted_total,
+                run.rejected_total,
+                run.dt_low,
+                run.dt_high,
+            )
+            return None
+        base, stop, dt_min = run.levels[-1], run.stops[0], self._dt_min
+        remaining = stop - base.t
+        if len(run.levels) == 1:  # the Euler start step leaves room for the second step of its pair
+            if remaining <= 2.0 * dt_min:
+                h = min(run.dt, remaining)
+            else:
+                h = min(run.dt, self._dt_max, 0.5 * remaining)
+        else:
+            h = _next_h(min(run.dt, self._dt_max), remaining)
+        t_new = stop if h == remaining else base.t + h
+        run.trial = (t_new, h)
+        return base, t_new, h
+
+    def judge(self, trial: State | None, failure: Exception | None):
+        """The states the trial's outcome accepts (none, one or two), after the controller."""
+        run, ctl, dt_min = self._run, self._ctl, self._dt_min
+        t_new, h = run.trial
+        fail = _failure(trial, failure)
+        if fail is not None:
+            if h <= dt_min * (1.0 + 1e-9):
+                raise _floor_error(self._stepper, run, t_new, h, dt_min, fail)
+            _reject(run, 1, max(RETRY_FACTOR * h, dt_min), fail.reason, t_new, h)
+            return
+        run.load_scale = max(run.load_scale, abs(_load(trial)))
+        if len(run.levels) == 1:  # the Euler start step: judged with the next step
+            run.levels.append(trial)
+            run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0
+            run.dt = h
+            yield from self._arrived()
+            return
+        if run.pending is not None:  # the second step judges the Euler start step
+            err, p = _start_error(run, trial), 1
+        else:
+            err, p = _milne(run, trial, self._order), self._order
+        if not ctl.accepts(err):
+            self._refuse(err, p, t_new, h)
+            return
+        if run.pending is not None:
+            yield from _emit(run, run.pending, run.pending_rejected, err)
+        yield from _emit(run, trial, run.rejected, err)
+        run.rejected = 0
+        run.levels = (run.levels + [trial])[-3:]
+        f = ctl.factor(err, p, grow=run.grow, dt=h)
+        if 1.0 <= f < ctl.hold:  # small growth is not worth a new operator
+            f = 1.0
+        run.dt = min(self._dt_max, max(dt_min, h * f))
+        run.grow = True
+        run.streak = 0
+        yield from self._arrived()
+
+    def _refuse(self, err: float, p: int, t_new: float, h: float):
+        """Reject a trial whose error is above tol (the start pair with it, if pending)."""
+        run, ctl, dt_min = self._run, self._ctl, self._dt_min
+        if h <= dt_min * (1.0 + 1e-9):
+            raise _floor_error(self._stepper, run, t_new, h, dt_min, None, err)
+        if run.pending is not None:  # reject the pair: back to the level before it
+            h1 = run.pending.t - run.levels[0].t
+            if h1 <= dt_min * (1.0 + 1e-9):
+                raise _floor_error(self._stepper, run, t_new, h1, dt_min, None, err)
+            run.levels = run.levels[:1]
+            run.rejected += run.pending_rejected + 1
+            run.pending = None
+            new = max(h1 * ctl.factor(err, 1, grow=False, dt=h1), dt_min)
+            _reject(run, 1, new, f"start pair error {err:.3g} > tol", t_new, h1)
+            run.rejected_total += 1
+        else:
+            run.streak += 1
+            f = ctl.factor(err, p, grow=False, dt=h)
+            if run.streak > 1:  # the estimate is not asymptotic here: cut hard
+                f = min(f, ctl.fac_min)
+            _reject(run, 1, max(h * f, dt_min), f"error {err:.3g} > tol", t_new, h)
+
+    def _arrived(self):
+        """At a stop: emit a pending Euler start step that reached it alone; past a breakpoint
+        the derivatives jump, so the run restarts there."""
+        run = self._run
+        if run.stops[0] - run.levels[-1].t > self._eps:
+            return
+        stop = run.stops.pop(0)
+        if run.pending is not None:
             yield from _emit(run, run.pending, run.pending_rejected, math.nan)
-        if stop < t_end:  # a breakpoint: the derivatives jump, restart
+        if run.stops:
             run.levels = [_restart(run.levels[-1])]
             run.origin = run.levels[0].t
-            run.dt = min(run.dt, dt0)
+            run.dt = min(run.dt, self._dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
-    logger.info(
-        "femehl: adaptive run to t = %.6g: %d accepted steps, %d rejected trials, dt in [%.3g, %.3g]",
-        t_end,
-        run.accepted_total,
-        run.rejected_total,
-        run.dt_low,
-        run.dt_high,
-    )
+
+
+def _failure(trial: State | None, exc: Exception | None) -> _Failure | None:
+    """Why a trial failed (it raised, or its film is <= 0 somewhere), None if it did not."""
+    if isinstance(exc, FilmRuptureError):
+        return _Failure(str(exc), tuple(exc.where), exc.d_min)
+    if exc is not None:
+        return _Failure(f"singular step ({exc})")
+    if not film_positive(trial):
+        d, at, label = film_floor(trial)
+        return _Failure(f"film {d:.3g} <= 0", at, d, label)
+    return None
 
 
 def _emit(run: _Run, state: State, rejected: int, err: float):
@@ -493,71 +491,3 @@ def _reject(run: _Run, n: int, new_dt: float, what: str, t: float, h: float):
     run.grow = False
     logger.debug("adaptive: t = %.6g, dt = %.3g rejected (%s); retry with dt = %.3g", t, h, what, new_dt)
     run.dt = new_dt
-
-
-def _advance(stepper, run: _Run, ctl: StepController, order: int, stop: float, dt_min: float, dt_max: float):
-    """One trial step toward ``stop``; yields the states it accepts (none, one or two)."""
-    base = run.levels[-1]
-    remaining = stop - base.t
-    start_step = len(run.levels) == 1
-    if start_step:  # the Euler start step leaves room for the second step of its pair
-        h = min(run.dt, remaining) if remaining <= 2.0 * dt_min else min(run.dt, dt_max, 0.5 * remaining)
-    else:
-        h = _next_h(min(run.dt, dt_max), remaining)
-    t_new = stop if h == remaining else base.t + h
-    trial, fail = _try(stepper, base, t_new, h)
-    if fail is not None:
-        if h <= dt_min * (1.0 + 1e-9):
-            raise _floor_error(stepper, run, t_new, h, dt_min, fail)
-        _reject(run, 1, max(RETRY_FACTOR * h, dt_min), fail.reason, t_new, h)
-        return
-    run.load_scale = max(run.load_scale, abs(_load(trial)))
-    if start_step:
-        run.levels.append(trial)
-        run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0
-        run.dt = h
-        return
-    if run.pending is not None:  # the second step judges the Euler start step
-        err, p = _start_error(run, trial), 1
-    else:
-        err, p = _milne(run, trial, order), order
-    if not ctl.accepts(err):
-        if h <= dt_min * (1.0 + 1e-9):
-            raise _floor_error(stepper, run, t_new, h, dt_min, None, err)
-        if run.pending is not None:  # reject the pair: back to the level before it
-            h1 = run.pending.t - run.levels[0].t
-            if h1 <= dt_min * (1.0 + 1e-9):
-                raise _floor_error(stepper, run, t_new, h1, dt_min, None, err)
-            run.levels = run.levels[:1]
-            run.rejected += run.pending_rejected + 1
-            run.pending = None
-            _reject(
-                run,
-                1,
-                max(h1 * ctl.factor(err, 1, grow=False, dt=h1), dt_min),
-                f"start pair error {err:.3g} > tol",
-                t_new,
-                h1,
-            )
-            run.rejected_total += 1
-        else:
-            run.streak += 1
-            f = ctl.factor(err, p, grow=False, dt=h)
-            if run.streak > 1:  # the estimate is not asymptotic here: cut hard
-                f = min(f, ctl.fac_min)
-            _reject(run, 1, max(h * f, dt_min), f"error {err:.3g} > tol", t_new, h)
-        return
-    if run.pending is not None:
-        yield from _emit(run, run.pending, run.pending_rejected, err)
-    yield from _emit(run, trial, run.rejected, err)
-    run.rejected = 0
-    run.levels = (run.levels + [trial])[-3:]
-    f = ctl.factor(err, p, grow=run.grow, dt=h)
-    if 1.0 <= f < ctl.hold:  # small growth is not worth a new operator
-        f = 1.0
-    run.dt = min(dt_max, max(dt_min, h * f))
-    run.grow = True
-    run.streak = 0
-
-
-# ---- drivers ------------------------------------------------------------------------------

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from femehl.errors import SceneError, SolverError
 from femehl.output.result import Result
 from femehl.problem.scene import Scene
-from femehl.solver.stepping import State, march
+from femehl.solver.stepping import FixedSteps, State, march
 from femehl.solver.threads import one_blas_thread
 
 __all__ = ["make_stepper", "methods", "run_loop", "run_scene"]
@@ -84,9 +84,10 @@ def run_loop(
     """The one driver loop: march ``stepper`` and feed every State to a Result and ``on_state``.
 
     Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
-    here.  Fixed steps ``dt`` (:func:`femehl.solver.stepping.march`), or adaptive steps to
-    ``step_tol`` (:func:`femehl.solver.adaptive.march_adaptive`, ``dt`` the first step, ``controls``
-    its ``dt_min``, ``dt_max``, ``safety``).  ``start`` resumes from a State (its own
+    here.  The step policy: fixed steps ``dt`` (:class:`femehl.solver.stepping.FixedSteps`),
+    or adaptive steps to ``step_tol`` (:class:`femehl.solver.adaptive.AdaptiveSteps`, ``dt``
+    the first step, ``controls`` its ``dt_min``, ``dt_max``, ``safety``), both walked by the
+    one time loop :func:`femehl.solver.stepping.march`.  ``start`` resumes from a State (its own
     record is kept, ``on_state`` is not called for it).  If the run stops on a
     :class:`~femehl.errors.SolverError` or is interrupted, the partial Result is attached
     to the exception as ``.result`` and the exception propagates; everything fed to
@@ -97,13 +98,14 @@ def run_loop(
     if step_tol is None:
         if controls:
             raise SceneError(f"{sorted(controls)} tune adaptive steps: give step_tol= as well.")
-        states = march(stepper, t_end, 0.01 if dt is None else dt, start=start)
+        policy = FixedSteps(0.01 if dt is None else dt)
     else:
-        from femehl.solver.adaptive import march_adaptive
+        from femehl.solver.adaptive import AdaptiveSteps
 
         if dt is not None:
             controls.setdefault("dt0", dt)
-        states = march_adaptive(stepper, t_end, tol=step_tol, start=start, **controls)
+        policy = AdaptiveSteps(step_tol, **controls)
+    states = march(stepper, t_end, policy, start=start)
     result = Result(scene=stepper.scene, method=stepper.method, disc=stepper.disc)
     last = None
     rejected, dts = 0, []

@@ -1,11 +1,11 @@
-"""The time loop as a generator of :class:`State`, shared by every solver.
+"""The one time loop (:func:`march`), the :class:`State` it yields and the time schemes.
 
-A *stepper* (:class:`femehl.solver.stepper.LaggedStepper`, the same for every
-method) builds its operators once and advances one step; this module only
-walks time.  The scheme is the paper's
-(section 3): every nonlinear coefficient is lagged one step, so each step is
-ONE linear solve.  ``march`` yields the initial state and then one state per
-step, so a caller can stop, store or plot whenever it likes.
+A *stepper* (:class:`femehl.solver.stepper.LaggedStepper`, the same for every method)
+builds its operators once and advances one step (ONE linear solve, docs/design.md
+section 3); a step policy (:class:`FixedSteps`, or
+:class:`femehl.solver.adaptive.AdaptiveSteps`) chooses the steps; ``march`` yields the
+initial state and then every accepted state, so a caller can stop, store or plot whenever
+it likes.
 """
 
 from __future__ import annotations
@@ -18,12 +18,13 @@ from typing import Protocol
 
 import numpy as np
 
-from femehl.errors import FilmRuptureError, SceneError
+from femehl.errors import FilmRuptureError, SceneError, SingularSystemError
 
 __all__ = [
     "State",
     "Stepper",
     "march",
+    "FixedSteps",
     "check_run",
     "Scheme",
     "SCHEMES",
@@ -124,34 +125,70 @@ def get_scheme(name: str) -> Scheme:
     return SCHEMES[name]
 
 
-def march(stepper: Stepper, t_end: float, dt: float, start: State | None = None) -> Iterator[State]:
-    """Yield the initial state, then one :class:`State` per step up to ``t_end``.
+class FixedSteps:
+    """The step policy of fixed steps ``dt``: steps land on ``k dt``, the last is shortened to
+    land on ``t_end``; a step that fails raises (nothing is retried)."""
 
-    The last step is shortened so the run ends exactly at ``t_end``.  With ``start``
-    (a State of an earlier run, e.g. from a checkpoint) the run continues from it.  A film
-    thickness reaching zero raises :class:`~femehl.errors.FilmRuptureError`
-    from the step that produced it (everything yielded before stays valid).
-    """
-    t_end, dt, n = check_run(t_end, dt)
-    if start is None:
-        state = stepper.initial_state()
-        k0 = 0
-    else:
-        state = start
-        k0 = int(round(start.t / dt))
-        if abs(k0 * dt - start.t) > 1e-9 * max(1.0, start.t):
-            raise SceneError(
-                f"cannot resume at t = {start.t:g} with dt = {dt:g}: resume with the dt of the original run."
-            )
-    yield state
-    for k in range(k0 + 1, n + 1):
-        t_new = min(k * dt, t_end)
-        h = t_new - state.t
+    def __init__(self, dt: float):
+        self.dt = dt
+
+    def begin(self, stepper: Stepper, t_end: float, start: State | None) -> State:
+        self._t_end, self._dt, self._n = check_run(t_end, self.dt)
+        if start is None:
+            self._k = 0
+            state = stepper.initial_state()
+        else:
+            self._k = int(round(start.t / self._dt))
+            if abs(self._k * self._dt - start.t) > 1e-9 * max(1.0, start.t):
+                raise SceneError(
+                    f"cannot resume at t = {start.t:g} with dt = {self._dt:g}: "
+                    "resume with the dt of the original run."
+                )
+            state = start
+        self._last = state
+        return state
+
+    def propose(self):
+        if self._k >= self._n:
+            return None
+        t_new = min((self._k + 1) * self._dt, self._t_end)
+        h = t_new - self._last.t
         if h <= 1e-14:
-            break
-        state = stepper.step(state, t_new, h)
-        _check_film(state)
-        yield state
+            return None
+        return self._last, t_new, h
+
+    def judge(self, trial: State | None, failure: Exception | None):
+        if failure is not None:
+            raise failure
+        _check_film(trial)
+        self._k += 1
+        self._last = trial
+        yield trial
+
+
+def march(stepper: Stepper, t_end: float, steps, start: State | None = None) -> Iterator[State]:
+    """The one time loop: yield the initial state, then every accepted state up to ``t_end``.
+
+    ``steps`` is the step policy: a number (fixed steps of that size, :class:`FixedSteps`) or
+    a policy object with ``begin(stepper, t_end, start) -> State`` (the first state),
+    ``propose() -> (base, t_new, dt) | None`` (the next trial step, None when done) and
+    ``judge(trial, failure)``, a generator of the states the trial's outcome accepts
+    (:class:`femehl.solver.adaptive.AdaptiveSteps` retries and rejects; fixed steps raise).
+    Each trial is ONE call of ``stepper.step``: one linear solve.  With ``start`` (a State
+    of an earlier run, e.g. from a checkpoint) the run continues from it.  A film
+    thickness reaching zero raises :class:`~femehl.errors.FilmRuptureError` (everything
+    yielded before stays valid).
+    """
+    policy = FixedSteps(steps) if not hasattr(steps, "propose") else steps
+    yield policy.begin(stepper, t_end, start)
+    while (trial := policy.propose()) is not None:
+        base, t_new, h = trial
+        try:
+            new = stepper.step(base, t_new, h)
+        except (FilmRuptureError, SingularSystemError) as exc:
+            yield from policy.judge(None, exc)
+        else:
+            yield from policy.judge(new, None)
 
 
 def film_floor(state: State) -> tuple:

@@ -233,7 +233,7 @@ def _run(args, argv=()):
         run["dtheta"] = math.pi / check_divisions(args.dtheta_divisions)
     if method == "fd":
         # the coarsest FD grid found to survive the paper case's sliding start-up
-        # (coarser ones rupture at the exit: see the FD module docstring)
+        # (coarser ones rupture at the exit: see docs/design.md section 5)
         run.setdefault("dr", 0.0125)
         run.setdefault("dtheta", math.pi / 36)
     out = args.out or f"{DEFAULT_OUT}/{name}"

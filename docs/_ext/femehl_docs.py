@@ -226,9 +226,9 @@ class SolveOptions(Directive):
                     sol,
                 )
         group(
-            "Adaptive time steps (expert mode with ``tol``)",
-            "femehl.solver.adaptive.march_adaptive",
-            adaptive.march_adaptive,
+            "Adaptive time steps (expert mode with ``step_tol``)",
+            "femehl.solver.adaptive.AdaptiveSteps",
+            adaptive.AdaptiveSteps,
             names=set(adaptive.CONTROLS),
         )
         group(

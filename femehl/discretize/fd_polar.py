@@ -1,46 +1,11 @@
 """The paper-faithful polar finite differences (Wu, Hui et al. 2022, section 3).
 
-Discretization (Eqs. 13-26)
----------------------------
-The Reynolds equation in polar form (Eq. 13a), with mobility ``m`` (``d^3``, Eq. 13b),
-
-    beta [ p_r N + p_rr m + (p_thth m + M p_th) / r^2 ] = -V (cos(th) d_r - sin(th)/r d_th) + d_t,
-    N = m/r + m_r,   M = m_th       (for m = d^3: N = d^2 (d/r + 3 d_r), M = 3 d^2 d_th)
-
-is written at every interior node (0 < i < m-1, 0 < j < n-1) with forward first
-differences and central second differences (Eq. 19), the coefficients m, N, M taken
-from step k (lagged), and d = h - w at step k+1 on the right: the derivatives of
-d^{k+1} are forward differences (Eq. 19c,d) and d_t the scheme's backward difference.
-
-Eq. 20 of the paper is garbled in the text (F appears twice; F, G, H are printed as
-multiplying pressure neighbours while they are the w-coefficients of Eq. 22).  femehl
-rebuilds it from Eq. 15 term by term instead of copying Eqs. 20-23: the pressure stencil
-
-    p_{i,j+1}: N/dr + m/dr^2          p_{i,j-1}: m/dr^2
-    p_{i+1,j}: m/(r^2 dth^2) + M/(r^2 dth)   p_{i-1,j}: m/(r^2 dth^2)
-    p_{i,j}:   -(sum of the four)
-
-(Eq. 21 divided by dr^2), the w terms entering through d = h + C p.  The derivatives
-m_r and m_th in N and M are formed by the chain rule from forward differences of d^k
-(``m_r = dm/dd d_r``; backward at the outer row), not from the exact r, so any indenter
-shape works.  In the residual form of :mod:`femehl.solver.terms` the rows are the node
-equations multiplied by -1: ``poiseuille = -L``, ``couette = -G`` (G the forward
-difference ``cos(th) d_r - sin(th)/r d_th``) and ``squeeze = S`` (the row selection).
-
-Boundary conditions: p_{i,0} = p_{i,1} (Eq. 17a), p_{0,j} = p_{1,j} and
-p_{m-1,j} = p_{m-2,j} (Eq. 17b), p_{i,n-1} = 0 (Eq. 18a); they are imposed by
-eliminating the boundary nodes (an expansion matrix E from the free interior unknowns
-to all nodes).  Elasticity w = -c chi p (Eq. 25) with chi the polar cell influence of
-Eq. 24 including the mirror half theta in [pi, 2 pi].
-
-Stability (measured, paper case beta = 200, h0 = 0.1): the forward differences are
-downwind on the exit side (theta > pi/2, where the substrate carries the film toward
-growing r and theta), so where the film is thin the discrete operator loses its sign
-structure and the film ruptures.  Grids dr = 0.05 (t = 1.64), dr = 0.025 with
-dtheta = pi/24 (t = 2.57) or pi/36 (t = 2.62) stop with FilmRuptureError during the
-sliding start-up; dr = 0.0125, dtheta = pi/36 runs to t = 5.  The paper itself used
-dr = 0.01, dtheta = pi/60.  The linear system is the monolithic (p, w) system of Eq. 26
-with w eliminated, solved by a dense LU per step as in the paper.
+The Reynolds equation in polar form (Eq. 13) on a uniform (theta, r) grid: forward first
+and central second differences, the coefficients lagged one step, Eq. 20 rebuilt from
+Eq. 15, the boundary nodes eliminated, the polar cell influence of Eq. 24 with the mirror
+half, and the (p, w) system of Eq. 26 solved by a dense LU per step.  The stencil, the
+boundary conditions and the measured stability (coarse grids rupture at the exit):
+docs/design.md section 5.
 """
 
 from __future__ import annotations
@@ -101,7 +66,7 @@ class FDDisc:
         Its indenter must be symmetric in y (the grid is the half plane y >= 0).
     dr : float, default: 0.0125
         Radial step (L/dr must be an integer).  The default is the coarsest grid found
-        to carry the paper case through its sliding start-up (see the module notes).
+        to carry the paper case through its sliding start-up (docs/design.md section 5).
     dtheta : float, default: pi/36
         Azimuthal step (pi/dtheta must be an integer).
     """

@@ -1,83 +1,12 @@
 """Meshes fitted to the scene: refined where the contact of *this* run is.
 
-The mesh ladder (:data:`femehl.discretize.mesh.LADDER`) is graded for the paper sphere's
-contact annulus ``0.8 <= r <= 1.2``.  Another indenter puts its contact edge
-elsewhere: the shipped ellipsoid (``Rx = 0.5, Ry = 2, hc = -0.5``) has a contact
-semi-axis 0.44 along x and its exit minimum film near ``x = -0.5``, inside the
-ladder's coarse contact zone, and the ``medium`` rung is 11-13 % low in the
-minimum film at ``t = 3``.  This module meshes the disk from the scene itself::
-
-    from femehl.discretize.fitted import fitted_disk
-    res = femehl.solve(scene, t_end=5.0, mesh=fitted_disk(scene, 5.0), scheme="bdf2")
-
-Two steps
----------
-:func:`contact_extent` estimates the largest dry-contact semi-axes ``(ax, ay)``
-of the run (Hertz / Sneddon / Winkler, see there).  :func:`fitted_sizes` turns
-them into a size field, :func:`fitted_disk` meshes it with gmsh through
-:func:`femehl.discretize.mesh.sized_disk` (the ladder's mesher and options) and caches
-the result on disk.
-
-The size field
---------------
-The contact is modelled as the ellipse ``rho(x, y) = 1`` with
-``rho = sqrt((x/ax)^2 + (y/ay)^2)``.  Its local normal length scale is
-``ell(x, y) = 1/|grad rho|`` (constant along rays; ``ax`` on the x axis, ``ay``
-on the y axis, in ``[min(ax, ay), max(ax, ay)]``), and ``dn = (rho - 1) ell``
-approximates the signed distance to the contact edge (exact on the axes).
-With ``a_min = min(ax, ay)`` and sizes multiplied by ``level``:
-
-* contact zone ``rho <= 1.3``: ``h_contact = min(0.095, 2.4 * 0.2035 W(beta))
-  a_min`` (the ``medium`` rung's 0.095 for the unit sphere; ``a_min`` because
-  the triangles are isotropic and must resolve the short axis; at most 2.4 times
-  the edge size, see "Thin films" below);
-* edge band ``|dn| <= w``, ``w = W(beta) ell``: ``h_edge = 0.2035 w`` (about
-  ten elements across the band ``2 w``; ``0.0407`` at ``beta = 200``, the
-  ``medium`` rung's edge size), growing linearly to ``h_contact`` over
-  ``0.15 ell`` on either side (the ladder's transition);
-* far field: linear along each ray from ``h_contact`` on ``rho = 1.3`` to
-  ``h_far = 0.152 L`` at ``r = L`` (the ``medium`` rung's 0.303 for ``L = 2``).
-
-So for the paper sphere at ``beta = 200`` and ``level = 1`` the field is the
-``medium`` rung's, and ``level = 1/1.45`` divides every size by 1.45 like one
-ladder rung (about twice the elements).
-
-Edge-band width
----------------
-``W(beta) = max(0.05, 1.17 beta^(-1/3))``: 0.2 at ``beta = 200`` (the
-ladder's annulus half-width, tuned on the paper sphere).  The band must hold
-the exit zone: the film's exit minimum sits past the Hertz edge and the film
-then opens.  Measured on the paper sphere (``benchmarks/fitted_mesh.md``,
-fine ladder mesh, ``t = 3``, centreline): the distance ``e`` from the Hertz
-edge to where the film past its exit minimum has doubled is 0.366, 0.165,
-0.083 at ``beta = 20, 200, 2000``, i.e. ``e ~ beta^(-0.32)``; ``W`` is 1.1-1.2
-times ``e`` at all three.  (A Hertzian boundary-layer argument, gap opening
-like ``(x/ell)^(3/2)`` and films ``h ~ beta^(-0.6)``, predicts ``beta^(-0.4)``
-for the constriction itself; the measured zone, which includes the opening,
-shrinks more slowly.)  The floor 0.05 keeps the band resolvable on a mesh for
-``beta >~ 10^4``.
-
-Thin films: the contact zone
-----------------------------
-Up to 2026-12-03 the contact zone was ``0.095 a_min`` at every beta, 9.3 times the
-edge size at ``beta = 20000``.  There, during the approach, the minimum film is on
-the rim of the trapped dimple, which crosses the contact zone (r ~ 0.2 to the edge):
-on the ``sphere_b20000_approach`` scene of ``benchmarks/auto_scenes.py`` (BDF2,
-dt = 0.0025, to t = 1; ``benchmarks/fitted_thin.md``) the uncapped levels 1 and 0.7
-(10,846 and 21,842 elements) are 27 % and 11 % off the finest capped mesh (level 0.7,
-50,120 elements) in the minimum film (central film 3.8 % and 2.0 %), the capped
-levels 1.4 and 1 (12,778 and 24,736 elements) 2.0 % and 1.25 % (0.33 % and 0.11 %).
-The cap ``C_CONTACT_EDGE = 2.4`` keeps every
-mesh of ``beta <= 218`` as it was (their ratio is at most 2.33).
-
-Accuracy (``benchmarks/fitted_mesh.md``, before the cap for beta = 2000): on the shipped ellipsoid (both
-orientations) a fitted mesh with the element count of the ``medium`` rung
-(``level = 1.45``) is within 1 % of the extrapolated minimum film at
-``t = 3``, where the ``medium`` rung is 11-13 % low (``xfine``, four times the
-elements: about 2 %); on the paper sphere the fitted ``level = 1`` mesh is the
-``medium`` rung's field (both within 1 %).  At ``beta = 2000`` the narrower
-band makes the fitted mesh at the medium count 3.7 % low (``medium``: 8.7 %,
-``fine``: 6.2 %); ``level = 1`` (the fine count) is within 1 %.
+:func:`contact_extent` estimates the largest dry-contact semi-axes of the run,
+:func:`fitted_sizes` turns them into a size field (a contact zone, an edge band of
+half-width ``W(beta)``, a far field) and :func:`fitted_disk` meshes it with gmsh through
+:func:`femehl.discretize.mesh.sized_disk` and caches it: ``femehl.solve(scene, t_end=5.0,
+mesh=fitted_disk(scene, 5.0), scheme="bdf2")``.  The size field, the measurements behind
+its constants and the accuracy against the mesh ladder: docs/design.md section 4
+("Meshes fitted to the scene").
 """
 
 from __future__ import annotations
@@ -153,7 +82,7 @@ def contact_extent(scene, t_end: float) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class FittedSizes:
-    """The size field of a fitted mesh (see the module docstring).
+    """The size field of a fitted mesh (docs/design.md section 4).
 
     Attributes
     ----------

@@ -1,76 +1,11 @@
 """Triangulated disks for the P1 finite-element Reynolds solver.
 
-What the meshes are
--------------------
-femehl solves the Reynolds equation on a disk of radius ``L`` (normalized
-units: the Hertzian contact radius is about 1, so ``L = 2`` leaves one contact
-radius of inlet/outlet around the contact).  A problem that is symmetric about
-the rolling direction is solved on the *half* disk ``y >= 0`` with the mirror
-line ``y = 0`` as a symmetry boundary; otherwise on the *full* disk.  A mesh is
-held in a :class:`DiskMesh`: a linear-triangle :class:`skfem.MeshTri` plus the
-radius, the half/full flag and where it came from.
-
-Grading
--------
-:func:`graded_disk` meshes the disk with gmsh (Frontal-Delaunay, one thread,
-fixed seed: the output is reproducible) under a radial mesh-size function
-``h(r)``:
-
-* ``h = h_edge`` in the annulus ``r_edge[0] <= r <= r_edge[1]``, where the
-  pressure drops to zero at the contact edge and the film has its exit
-  constriction;
-* ``h = h_contact`` inside ``r < r_contact`` away from that annulus, reached
-  from ``h_edge`` linearly over a transition width of 0.15 (normalized
-  units) on either side of the annulus;
-* ``h`` grows linearly in ``r`` from ``h_contact`` at ``r_contact`` to
-  ``h_far`` at ``r = L``.
-
-``h(r)`` is homogeneous of degree one in ``(h_edge, h_contact, h_far)``, so
-multiplying the three sizes by ``s`` shrinks every element by ``s``.  The
-mesh ladder :data:`LADDER` (``coarse``, ``medium``, ``fine``, ``xfine``) does
-exactly that with ``s = 1/1.45`` (about ``1/sqrt(2)``) between rungs: each rung
-has about twice the elements of the one before (half disk, ``L = 2``: about
-1470, 2980, 6090, 12680), so convergence rates can be read off.  Boundary
-nodes are placed exactly on the circle ``r = L`` and on the mirror line
-``y = 0``; the origin is always a node.
-
-:func:`sized_disk` is the same mesher under any size field ``h(x, y)``; the
-scene-fitted meshes of :mod:`femehl.discretize.fitted` (``fitted_disk(scene, t_end)``,
-refined at the contact of that scene) use it.
-
-The ladder is shipped as gmsh files ``meshes/half_<name>.msh`` and
-``meshes/full_<name>.msh`` in the repository; regenerate them with::
-
-    python meshes/make_ladder.py
-
-If a ladder file is missing (an installed package has no ``meshes`` folder),
-:func:`ladder_path` generates it and caches it, in the repository's ``meshes``
-folder if that exists and is writable, else in ``~/.cache/femehl``.
-
-Checks
-------
-:func:`load_mesh` accepts a ladder name, any file meshio reads, a
-:class:`skfem.MeshTri` or a :class:`DiskMesh`, and checks that it is a valid
-triangulation of the requested disk.  Each failure raises
-:class:`~femehl.errors.MeshError` saying what to do:
-
-* the file exists and meshio reads it; it has ``triangle`` cells (other cells
-  are ignored, ``z`` is dropped, unused nodes are dropped);
-* coordinates are finite; no triangle is degenerate (area ``> 1e-12 L^2``);
-* no two triangles overlap (each oriented edge is used at most once);
-* the mesh is one connected piece without holes (its boundary is a single
-  closed loop);
-* for a half disk every node has ``y >= -1e-12 L``;
-* the mesh radius (largest node radius) equals ``L`` to ``1e-9`` relative;
-* the mesh covers the disk: its area equals ``pi L^2`` (``pi L^2 / 2`` for a
-  half disk) to a relative tolerance that allows for the polygonal boundary
-  (see :func:`load_mesh`), and every boundary node lies on ``r = L`` or, for a
-  half disk, on ``y = 0``.
-
-Every triangle is then oriented counterclockwise by its signed area, boundary
-nodes are snapped exactly onto ``r = L`` / ``y = 0`` (they move by at most
-``1e-9 L``), and the mesh is built with ``skfem.MeshTri(p, t, sort_t=False)``
-so the orientation is kept.  Input objects are never mutated.
+A mesh is a :class:`DiskMesh` (a :class:`skfem.MeshTri` of the disk ``r <= L`` or of the
+half disk ``y >= 0``, with its radius and origin).  :func:`graded_disk` meshes it with gmsh
+under a radial size function, the :data:`LADDER` rungs (``coarse`` to ``xfine``) each
+doubling the elements; :func:`sized_disk` under any size field; :func:`load_mesh` reads
+and checks any triangulation.  The grading, the ladder files and every check:
+docs/design.md section 4 ("The meshes") and ``meshes/README.md``.
 """
 
 from __future__ import annotations
@@ -641,7 +576,7 @@ def load_mesh(spec, L: float = 2.0, half: bool | None = None) -> DiskMesh:
     ------
     MeshError
         If the file is missing or unreadable, has no triangles, or the mesh
-        fails a check (see the module docstring); the message says how to fix
+        fails a check (docs/design.md section 4); the message says how to fix
         it.
 
     Notes

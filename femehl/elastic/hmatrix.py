@@ -1,38 +1,12 @@
 """A hierarchical (H^2) approximation of the Boussinesq operator: memory and work O(N log N).
 
-The dense elastic operator ``X[i, j] = int_{T_j} dA' / |c_i - x'|`` (element centroids
-``c_i``, triangles ``T_j``, :mod:`femehl.elastic.kernels`) costs ``8 N^2`` bytes.  This module
-approximates it as
-
-    X = X_near + sum over admissible blocks (tau, sigma) of  S_tau K_{tau sigma} Q_sigma,
-
-the standard H^2 matrix with Chebyshev interpolation (the "black-box FMM" of Fong and
-Darve 2009, with the block partition of an H-matrix):
-
-* two cluster trees, of the targets (centroids) and of the sources (triangles, with their
-  mirror images for a half disk), by bisection of bounding boxes at the median, leaves of
-  at most ``leaf`` items;
-* a block (tau, sigma) is *admissible* when ``max(diam tau, diam sigma) <= eta dist(tau,
-  sigma)`` (bounding boxes; the source box holds the whole triangles).  There the kernel
-  is interpolated on tensor Chebyshev grids of ``p x p`` points in both boxes:
-  ``1/|x - y| ~ sum_ab l_a(x) K(xi_a, eta_b) l_b(y)``; the error falls geometrically with
-  ``p`` (measured in ``benchmarks/fast_operator.md``);
-* every other block of two leaves is kept exactly (``X_near``, sparse): the exact
-  triangle integrals of :mod:`femehl.elastic.kernels`, so the singular and nearly singular
-  interactions are never approximated;
-* the grids are nested: a parent's moments are its children's, re-interpolated (exact
-  for the polynomials of degree ``p - 1``), so the cluster bases are stored only at the
-  leaves: ``Q`` (moments ``int_T l_b`` by a Gauss rule exact for the degree ``2 (p - 1)``)
-  and ``S`` (the Lagrange basis at the centroids).
-
-``X @ u`` is an upward pass (moments), one product per admissible block (``K`` kept with
-its singular values truncated at ``svd_tol`` relative to the block's largest, in one
-compiled pass over all blocks, :func:`_couple`), a downward pass and the sparse near
-field: no loop over elements or blocks in Python.  At the default tolerance the blocks'
-factors are stored in single precision (:data:`SINGLE_FACTORS_TOL`) and used in double
-precision arithmetic: half the far field's memory, a fixed linear map.
-The near-field entries within a few element sizes are also what the fast path's
-preconditioner factors (:class:`FastCompliance`, :mod:`femehl.solver.linsolve`).
+The dense operator ``X[i, j] = int_{T_j} dA' / |c_i - x'|`` (:mod:`femehl.elastic.kernels`)
+as an exact sparse near field plus Chebyshev-interpolated admissible blocks on two cluster
+trees (the "black-box FMM" of Fong and Darve 2009), the far factors stored in single
+precision at the default tolerance and used in double: :class:`FastCompliance`, whose near
+field is also the fast path's preconditioner (:mod:`femehl.solver.linsolve`).  The format,
+the one parameter ``operator_tol`` and the measurements behind its defaults:
+docs/design.md section 10.
 """
 
 from __future__ import annotations

@@ -1,39 +1,12 @@
 """Exact Boussinesq integrals of a uniform pressure over triangles and polar cells.
 
-Conventions (docs/design.md, section 4; paper Eq. 24-25)
---------------------------------------------------------
-The normalized deflection of an elastic half space under pressure p is
-``w(x) = -c * int p(x') / |x - x'| dA'`` (Eq. 10b; c = 2(1 - nu), 1 for the
-incompressible case).  This module computes the *kernel* part
-
-    I(A, T) = int_T dA' / |A - x'|
-
-exactly for a field point A and a triangle T, whatever A's position (inside,
-on an edge, on a vertex, outside).  Split T into the three triangles
-(A, P_i, P_i+1).  For an edge B -> C with unit vector e, signed distance
-``hA = (B - A) x e`` of A from the line and positions ``sB = (B - A).e``,
-``sC = (C - A).e`` along it, the triangle (A, B, C) contributes
-
-    hA * ( asinh(sC/|hA|) - asinh(sB/|hA|) )
-
-(the integral of 1/rho in polar coordinates about A, signed by the orientation
-of (A, B, C), which is the sign of hA).  The sum over the three edges, times
-the orientation sign of T, is I(A, T); an edge with hA = 0 contributes 0.
-The paper's quadrilateral BCDE (Eq. 24) is two such triangles.
-
-All functions are vectorized over field points and triangles and work in
-row blocks so that memory stays at the size of the output matrix.
-
-Radial kernels ``g(r) = a/r - R(r)`` with R smooth on a length ``scale`` (an elastic
-layer, :mod:`femehl.elastic.layer_kernel`): the ``a/r`` part exactly as above, R by the 7-point
-rule on triangles of diameter <= ``SMALL_TRIANGLE * scale`` and otherwise by the polar
-form about A, each edge B -> C contributing ``hA int F(sqrt(hA^2 + s^2)) ds`` with
-``F(r) = (1/r^2) int_0^r s R(s) ds`` (composite Gauss-Legendre within the kernel's cut-off,
-closed form beyond): exact whatever the triangle's size (:func:`radial_triangle_pairs`).
-Whole matrices: sparse within the cut-off (:func:`sparse_radial_influence`), or dense
-with the smooth part direct (:func:`smooth_matrix`), low-rank (:func:`smooth_lowrank`,
-one tensor Chebyshev interpolation) or on a uniform grid with an FFT convolution
-(:func:`smooth_grid_apply`).
+``I(A, T) = int_T dA' / |A - x'|`` exactly for any field point A (inside, on or outside the
+triangle T), one ``asinh`` term per edge (paper Eq. 24), vectorized over field points and
+triangles in row blocks; and radial kernels ``a/r - R(r)`` (an elastic layer,
+:mod:`femehl.elastic.layer_kernel`), their smooth part by the 7-point rule or the polar
+edge integrals, assembled sparse, dense, low-rank or by an FFT on a grid.  The formulas:
+docs/design.md section 4 ("Exact influence of a uniform pressure on a triangle") and
+section 14.
 """
 
 from __future__ import annotations

@@ -1,64 +1,11 @@
 """The surface Green's function of an elastic layer on a rigid base (normalized units).
 
-Conventions
------------
-femehl's normalized half space (Eq. 10b, :mod:`femehl.elastic.halfspace`) deflects by
-``w(x) = -c int p(x') / |x - x'| dA'`` with ``c = 2 (1 - nu)``; physically
-``w = (1 - nu)/(2 pi G) int p / r dA``, whose 2-D Fourier transform is
-``w~(k) = (1 - nu)/(G k) p~(k)``.  A layer of thickness ``h`` on a rigid base, loaded by a
-normal pressure on its frictionless top surface, multiplies that transform by ``K(k h)``:
-
-    w~(k) = (1 - nu)/(G k) K(k h) p~(k),
-
-    bonded base (u = 0 at z = -h):
-        K(t) = [2 kappa sinh(2t) - 4t] / [2 kappa cosh(2t) + 1 + kappa^2 + 4t^2],
-        kappa = 3 - 4 nu;
-    frictionless base (u_z = 0, sigma_xz = 0 at z = -h):
-        K(t) = [cosh(2t) - 1] / [sinh(2t) + 2t]      (independent of nu).
-
-These are the classical layer compliances (layers on a rigid base: Johnson, *Contact
-Mechanics*, 1985, and the layered-solid solutions it cites); the thin-layer limits below,
-Winkler for a compressible layer and ``lap p`` for an incompressible one, and when each
-holds, are discussed by Chandler & Vella, "Validity of Winkler's mattress model for thin
-elastomeric layers: beyond Poisson's ratio", Proc. R. Soc. A (2020), arXiv:2010.11133,
-with soft EHL as an example.  femehl does not rely on a printed formula:
-``tests/test_layer.py`` re-derives both numerically: a Fourier mode of the load makes a
-plane-strain problem in (x, z), whose Navier equations are integrated as a first-order
-system for (u_x, u_z, sigma_xz, sigma_zz) across the layer by a matrix exponential and
-matched to the boundary conditions; the two agree to <= 1e-12.
-
-Limits: ``K -> 1`` as ``t -> inf`` (the half space).  As ``t -> 0``, bonded
-``K ~ t (1 - 2 nu) / (2 (1 - nu)^2)``: the laterally confined (oedometric) Winkler
-foundation ``p / w = 2 G (1 - nu) / ((1 - 2 nu) h)``; at ``nu = 1/2``, ``K ~ 2 t^3 / 3``: the
-thin incompressible layer ``w = -(h^3 / (3 G)) lap p``.  Frictionless ``K ~ t / 2``:
-``p / w = 2 G / ((1 - nu) h)`` (uniaxial plane strain).  In femehl's units (pressure scale
-``4 pi G sqrt(h_inf/R)``, lengths ``sqrt(R h_inf)``, w in ``h_inf``; the half space's
-``w~ = -c (2 pi / k) p~``) the layer's ``w~ = -c (2 pi / k) K(k h) p~`` tends to femehl's
-``Winkler(k)`` with ``k = 1 / (2 pi c K'(0) h)``: ``(1 - nu) / (2 pi (1 - 2 nu) h)`` bonded,
-``1 / (2 pi (1 - nu) h)`` frictionless (:func:`winkler_limit`); the thin bonded
-incompressible layer is ``w = (4 pi h^3 / 3) lap p`` (:func:`thin_layer_factor`).
-
-The normalized Green's function is ``g(r) = c int_0^inf K(k h) J0(k r) dk = c [1/r - R(r)]``,
-
-    R(r) = (1/h) Rh(r/h),     Rh(rho) = int_0^inf (1 - K(t)) J0(t rho) dt,
-
-with ``1 - K`` decaying like ``t^2 e^(-2t)``, so ``Rh`` is analytic (in the strip
-``|Im rho| < 2``), finite at 0 and ``Rh -> 1/rho``.  ``K(k h)/k`` is even and analytic in
-``k``; ``g`` decays like ``exp(-y r/h)``, ``y`` the smallest imaginary part of the zeros of
-K's denominator: bonded ``y = 0.739`` at nu = 1/2 (the root of cos y = y), 0.913 at 0.3,
-1.190 at 0; frictionless 2.106.  Beyond ``cutoff`` (``|g| / c < 1e-14 / h``, about 45 h at
-nu = 1/2, 35 h at 0.3) ``R = 1/r`` to round-off and the layer does not feel a load.
-
-For exact triangle integrals about a field point (:func:`femehl.elastic.kernels.radial_triangle_pairs`)
-the table also holds ``F(r) = Q(r) / r^2``, ``Q(r) = int_0^r s R(s) ds``:
-
-    Fh(rho) = int_0^inf (1 - K(t)) J1(t rho)/(t rho) dt,     F(r) = Fh(r/h) / h,
-
-which beyond the cut-off is ``1/r - q h / r^2``, ``q = K'(0) = int_0^inf (1 - rho Rh) drho``.
-Both are tabulated once per (nu, bonded) by panel Gauss-Legendre Hankel integrals (on
-``t`` in [0, 24], where ``1 - K < 1e-17``) as cubic Hermite interpolants on two uniform
-grids (step 0.005 for rho <= 12, then ``1/rho - Rh`` with step 0.04): measured interpolation
-error <= 2e-12 of ``Rh(0)`` (``tests/test_layer.py``).
+A layer of thickness ``h`` multiplies the half space's transform by ``K(k h)`` (bonded or
+frictionless base, :func:`layer_factor`); its kernel is ``g = c (1/r - R(r))``, ``R``
+tabulated once per (nu, bonded) (:class:`LayerTable`, :class:`LayerKernel`) and ``1/r``
+beyond a cut-off of a few tens of ``h``.  The thin limits: :func:`winkler_limit`,
+:func:`thin_layer_factor`.  The conventions, the formulas and their references, the
+tabulation and its errors: docs/design.md section 14.
 """
 
 from __future__ import annotations
@@ -255,7 +202,7 @@ def _horner(x, x0, dx, c):
 
 
 class LayerTable:
-    """``Rh(rho)`` and ``Fh(rho)`` of one (nu, bonded), ``rho = r / h`` (see the module notes)."""
+    """``Rh(rho)`` and ``Fh(rho)`` of one (nu, bonded), ``rho = r / h`` (docs/design.md section 14)."""
 
     def __init__(self, nu=0.5, bonded=True):
         self.nu, self.bonded = float(nu), bool(bonded)

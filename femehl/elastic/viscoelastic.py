@@ -1,64 +1,11 @@
 """Viscoelastic substrate: a standard linear solid whose memory travels with the material.
 
-Constitutive law
-----------------
-A standard linear solid (Zener) in shear, with constant Poisson ratio, relaxes from the
-unrelaxed (instantaneous) modulus ``G0`` to the relaxed modulus ``G_inf`` with the
-stress-relaxation time ``tau``:
-
-    G(t) = G_inf + (G0 - G_inf) exp(-t / tau).
-
-Its creep compliance (the response to a unit step of stress) is
-
-    J(t) = J_inf - (J_inf - J0) exp(-t / tau_c),   J0 = 1/G0,  J_inf = 1/G_inf,
-    tau_c = tau G0 / G_inf                         (the retardation time, >= tau).
-
-Moduli are in units of the scene's shear modulus G (the one in ``beta``); ``G_inf = 1``
-(the default) makes the slow limit the elastic scene itself.  By the correspondence
-principle (constant Poisson ratio) every elastic substrate whose compliance is
-proportional to 1/G has the viscoelastic surface response
-
-    w(x, t) = -[ J0 u(X, t) + q(X, t) ],    u = C p  (the elastic operator at G = 1),
-    tau_c Dq/Dt = (J_inf - J0) u - q,
-
-with ``q`` the delayed (creep) part of the deflection, an internal variable on the film
-points, and ``D/Dt`` the material derivative.  ``elastic`` is that substrate
-(:class:`~femehl.elastic.HalfSpace` by default; any substrate of femehl's, e.g. a
-Winkler foundation, whose stiffness then relaxes the same way).
-
-Moving frame
-------------
-femehl works in the indenter's frame, where the substrate's material moves at ``-2 V(t)``
-along x (the film's mean speed is ``-V``: the Couette term ``-V dd/dx`` of the normalized
-Reynolds equation; docs/design.md section 2).  So the memory is carried with the
-material: ``D/Dt = d/dt - 2 V d/dx``.  :class:`CreepMemory` integrates it exactly along
-the characteristics (an exponential integrator; the source ``u`` linear in time over the
-step, its increment taken at the arrival point), so that ``q^{k+1} = offset + w u^{k+1}``
-is affine in the step's own ``u`` and the step's deflection is
-
-    w^{k+1} = -[ J_eff u^{k+1} + offset ],    J_eff = J0 + w,
-
-the elastic operator scaled by ``J_eff`` and a known film offset: each step is still ONE
-linear system (the stepper's, unchanged).  The path integral is a quadrature on
-sub-steps of one grid spacing of travel, so a steady sliding state does not depend on
-dt (measured on line contact: load within 1e-5 of the collocation reference of
-:mod:`femehl.reference.viscoelastic_line` at dt = 0.02 to 0.32; the earlier backward
-difference along the characteristics was 19 % off at dt = 0.32); in a transient the
-scheme is second order while the step's shift ``2 V dt`` is a fraction of the contact,
-which :meth:`Viscoelastic.step_limit` states for the adaptive steps.  A fixed step above
-it is allowed (expert mode): the memory stays exact in a steady state and bounded, only
-the transient's time accuracy is the user's choice, as for the film itself.
-``q`` lives on a uniform grid aligned with the sliding direction (cubic-spline shifts,
-no numerical diffusion to speak of, unlike linear interpolation on the unstructured
-film points, which lost 7 % of the memory in the test case).  Material entering the
-domain at the upstream rim carries no creep (q = 0: it has not been loaded yet).
-
-Limits
-------
-``tau -> infinity``: the unrelaxed elastic solid (compliance J0); ``tau -> 0``: the relaxed
-one (J_inf); ``G0 = G_inf``: the elastic solid itself, exactly (the internal variable
-stays 0).  Under a constant load in the dry limit the Hertz contact radius creeps as
-``a(t)^3 = a_H^3 J(t)/J0`` (Lee and Radok 1960, J. Appl. Mech. 27, 438).
+:class:`Viscoelastic` (unrelaxed and relaxed shear moduli ``G0``, ``G_inf`` in units of the
+scene's G, stress-relaxation time ``tau``) relaxes any elastic substrate by the
+correspondence principle: ``w = -(J0 C p + q)``, the creep ``q`` an internal variable that
+:class:`CreepMemory` carries with the material (``D/Dt = d/dt - 2 V d/dx``) by an exact
+exponential integrator on a uniform grid, so that each step is still one linear system.
+The constitutive law, the scheme, its step limit and the limits: docs/design.md section 15.
 """
 
 from __future__ import annotations

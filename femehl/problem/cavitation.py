@@ -1,63 +1,12 @@
 """Cavitation conditions: where the film cannot hold a pressure below ambient.
 
-Every femehl run without one is full Sommerfeld (the pressure may go below ambient).
-Three conditions are registered in :data:`CAVITATION_MODELS` (``Fluid(beta, cavitation=name)``,
-``LineScene(cavitation=name)``, ``[fluid] cavitation = name``):
-
-``"jfo"`` (:class:`JFOCavitation`)
-    The mass-conserving model (Jakobsson-Floberg-Olsson, Elrod-Adams): ``p >= 0`` and the
-    film content ``theta`` carried through the cavity, rupture and reformation both
-    conserving the liquid.  Still ONE linear system per step: each node's unknown is its
-    pressure (full film) or its gas film (cavitated), the set lagged one step.
-
-``"reynolds"`` (:class:`ReynoldsCavitation`)
-    The Reynolds (Swift-Stieber) condition ``p >= 0``: the pressure is 0 on a cavitated
-    set, the Reynolds equation holds elsewhere, and on the set its residual (the
-    multiplier ``lambda = A p - b``) is non-negative.  The step stays ONE linear system:
-    the set is lagged one step, like every other coefficient.  The cavitated rows of the
-    step's system are replaced by ``p_i = 0``
-    (:meth:`femehl.solver.linsolve.StepOperator.with_fixed`), and after the solve the
-    complementarity variable ``y = p`` off the set and ``y = -lambda`` on it decides the
-    next set: ``{y < 0}`` (a primal-dual active-set rule applied once per step).  At a
-    steady state the set stops changing and the discrete Reynolds condition holds exactly;
-    while it moves, a node can be negative for the one step before it joins the set (its
-    value is reported as ``state.info["p_negative_min"]``).
-``"half-sommerfeld"`` (:class:`HalfSommerfeld`)
-    The classic comparison condition (Guembel): the step is the full-Sommerfeld step
-    (the same system, the same film and deflection), and the negative pressures are
-    clipped after the solve in what is reported: ``state.p``, ``p_max``, ``load`` and
-    the series.  The full-Sommerfeld load of the same solution stays beside it
-    (``info["load_full"]``, summary column ``load_full``).  It is refused under an
-    imposed load or a free indenter (see :class:`HalfSommerfeld`).
-
-What each condition gets wrong:
-
-* **full Sommerfeld** (no condition): the film holds a tension (sub-ambient pressure)
-  that a liquid cannot hold; the sub-ambient lobe behind the contact lowers the load;
-* **half-Sommerfeld**: the clipped field does not satisfy the Reynolds equation; at the
-  cavitation boundary the pressure gradient jumps, so the flux is discontinuous and mass
-  is created; film and deflection are those of the full-Sommerfeld pressure, not of the
-  pressure reported;
-* **Reynolds (Swift-Stieber)**: ``p = 0`` and ``dp/dn = 0`` at rupture, so the flux is
-  continuous where the film ruptures and mass is conserved there; where the film
-  reforms it is not (no jump condition: mass is created or destroyed), and the film
-  content of the cavitated region is not known.  The multiplier on the held rows is the
-  volume the condition supplies to the full-film balance: the liquid created where the
-  film reforms, plus the cavity's gas growth and outflow (``info["full_film_source"]``,
-  see :class:`ReynoldsCavitation`);
-* **JFO** (Jakobsson-Floberg-Olsson, Elrod-Adams): conserves the liquid everywhere; what
-  it leaves out is the physics of the cavity itself (gas dissolution, vapour pressure
-  below ambient: the cavity pressure is ambient, 0) and, in femehl's scheme, the content
-  is carried by a first-order upwind transport (its front smeared over a few elements)
-  and the full/cavitated set is lagged one step (see :class:`JFOCavitation`).
-
-A model is a class with ``name``, ``changes_step`` (False: post-processing only, so the
-paper's FD reference accepts it), ``clips_pressure`` (the pictures say "clipped"),
-``columns`` (the summary.csv columns it adds, read from ``state.info``), ``note`` (how
-the reported fields are to be read), ``field_data`` (integer field data of the series),
-and the methods ``check_scene``, ``setup``, ``initial_info``, ``initial_state``,
-``lagged_pressure``, ``prepare`` (the step's system) and ``finish`` the stepper calls
-(:class:`femehl.solver.stepper.LaggedStepper`), and ``point_fields`` the series writes.
+Three conditions are registered in :data:`CAVITATION_MODELS` (``Fluid(beta,
+cavitation=name)``, ``LineScene(cavitation=name)``, ``[fluid] cavitation = name``):
+``"jfo"`` (:class:`JFOCavitation`, mass-conserving), ``"reynolds"``
+(:class:`ReynoldsCavitation`, ``p >= 0``) and ``"half-sommerfeld"`` (:class:`HalfSommerfeld`,
+negative pressures clipped after the full-Sommerfeld step); without one a run is full
+Sommerfeld.  Each keeps one linear system per step.  What each gets wrong, the schemes, a
+model's interface and the validation: docs/design.md section 13.
 """
 
 from __future__ import annotations
@@ -89,7 +38,7 @@ register_cavitation = CAVITATION_MODELS.register
 
 
 class _Model:
-    """What the registered models share (see the module docstring); a step part
+    """What the registered models share (docs/design.md section 13); a step part
     (:class:`femehl.solver.parts.StepPart`): its own variables ``p_aux`` (and JFO's ``gas``)."""
 
     name = ""

@@ -1,60 +1,11 @@
 """Line contact: a rigid cylinder sliding on a Winkler foundation (paper section 4).
 
-The problem
------------
-The cylinder's gap is ``s(x) = x^2/2`` (normalized units, radius 1), or any rigid
-gap profile ``s(x)`` the scene is given (``LineScene(profile=...)``: a textured or
-inclined slider), the substrate a Winkler foundation ``w = -p/k``, and the film
-thickness
-
-    d(x, t) = hc(t) + s(x) + p(x, t)/k            (d = h - w, w < 0 under p > 0)
-
-obeys the 1-D normalized Reynolds equation, with the same conventions as the
-2-D problem of :mod:`femehl.problem.scene` (docs/design.md, sections 1-2):
-
-    beta d/dx( d^3 dp/dx ) = -V(t) dd/dx + dd/dt      on -L < x < L,
-    p(-L) = p(L) = 0,    p(x, 0) = 0  so  d(x, 0) = hc(0) + s(x).
-
-The cylinder slides toward +x; in its frame the substrate moves toward -x,
-so the inlet is at x > 0 and the exit constriction at x < 0.  hc > 0 is a
-gap, hc < 0 an indentation.  Without a cavitation condition (full Sommerfeld) p may
-go negative (at the exit), as in the 2-D solvers; ``cavitation="jfo"``, ``"reynolds"`` or
-``"half-sommerfeld"`` as there (:mod:`femehl.problem.cavitation`).  The paper checks its scheme on this
-problem (Wu, Hui et al., JMPS 2022, section 4 and its SI) against the exact
-steady sliding solution, which :mod:`femehl.reference.line_steady` computes by
-quadrature and shooting.
-
-The scheme (paper section 3, femehl's FE form, docs/design.md, section 4)
--------------------------------------------------------------------------
-P1 pressure on a scikit-fem :class:`~skfem.MeshLine` (uniform or graded),
-the film on elements (P0): ``d_e = h(x_e) + (P p)_e / k`` with ``x_e`` the
-centroid and ``P`` the element average of a P1 field.  With ``d^3`` lagged
-one step, find p^{k+1} in P1, p = 0 at x = +-L, such that for every P1 test
-function q vanishing at +-L
-
-    beta int (d^k)^3 p' q'  +  V int d^{k+1} q'  +  int (d^{k+1} - d^k)/dt q  = 0
-
-(the Couette term integrated by parts; its boundary term vanishes since
-q(+-L) = 0).  With ``C = P/k`` (sparse: the Winkler foundation is local) this
-is ONE sparse linear system per step,
-
-    ( beta K(d^k) + V Bx C + M C/dt ) p = -V Bx h^{k+1} - M (h^{k+1} - d^k)/dt,
-
-with the forms of :mod:`femehl.discretize.forms` (K: ``film_diffusion``, Bx:
-``couette``, M: ``squeeze``).  No dense matrix is built anywhere.
-
-Imposed load per unit length ``F(t)`` instead of an imposed gap: hc^{k+1} is
-one more unknown (its column is ``V Bx 1 + M 1/dt``) and the row
-``int p dx = F(t^{k+1})`` borders the system; still one sparse solve per step,
-and the load is met to solver precision at every step.  ``motion.gap`` then
-only sets the initial clearance hc(0) (as for the 2-D solvers).
-
-``scheme="bdf2"`` (see :data:`femehl.solver.stepping.SCHEMES`) replaces the backward
-Euler difference by BDF2 and the lagged d^k by the extrapolation
-``2 d^k - d^{k-1}`` (variable-step forms); still one linear system per step.
-At a steady state (d^{k+1} = d^k = d^{k-1}) either scheme reduces to the
-steady weak form whatever dt, so long runs test the spatial discretization
-alone.
+:func:`LineScene` (a :class:`Cylinder`, or a rigid gap :class:`Profile` ``s(x)``, on a
+Winkler foundation ``w = -p/k`` over a :class:`LineDomain`) is a scene like the 2-D ones,
+with the same conventions: ``d = hc + s + p/k``, the cylinder sliding toward +x.  Its P1
+finite-element step is ONE sparse linear system, under an imposed gap or load, with
+backward Euler or BDF2.  The problem, the scheme and the imposed load: docs/design.md
+section 4 ("Line contact"); the exact steady solution: :mod:`femehl.reference.line_steady`.
 """
 
 from __future__ import annotations
@@ -257,7 +208,7 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
     profile: Callable | None = None,
 ) -> Scene:
     """A line contact: a :class:`femehl.Scene` with a :class:`LineDomain`, a rigid cylinder
-    (or a ``profile``) on a Winkler foundation ``w = -p/k`` (normalized units, module docstring).
+    (or a ``profile``) on a Winkler foundation ``w = -p/k`` (normalized units, docs/design.md section 4).
 
     Parameters
     ----------

@@ -1,62 +1,11 @@
 """TOML scene files: the CLI's way to state a scene (and how to run it).
 
-Each table names a *kind* looked up in a registry, never an if/elif chain:
-add a shape, substrate or time function by adding it to the registry.
-A commented example is ``examples/paper_sphere.toml``; the format::
-
-    [indenter]            kind = "sphere" (R) | "ellipsoid" (Rx, Ry)
-                          | "flat_punch" (a, edge_radius)
-                          | "heightmap" (file = "map.npz" | x, y, z [, symmetric_y])
-                          | "cylinder" (R = 1 only): line contact, see below
-    [substrate]           kind = "halfspace" (nu) | "winkler" (k) | "rigid"
-                          | "layer" (thickness, nu, bonded): an elastic layer on a
-                          rigid base, thickness in the units of x and y
-    [fluid]               beta = 200.0
-                          cavitation = "jfo" (optional: mass-conserving) | "reynolds"
-                          (p >= 0) | "half-sommerfeld"
-                          (negative pressures clipped after the full-Sommerfeld
-                          step; imposed gap only); default full Sommerfeld
-    [fluid.viscosity]     optional: kind = "barus" (alpha) | "roelands" (alpha, p_r, Z),
-                          normalized (see femehl.problem.viscosity); isoviscous without it
-    [motion.gap]          kind = "ramp_hold" (h0, h_end, t1) | "constant" (value)
-                          | "table" (times = [...], values = [...])
-    [motion.velocity]     kind = "tanh" (t1, T, V_ss) | "constant" | "table"
-    [motion.load]         optional imposed load F(t): a number or a time-function
-                          table as above; hc(t) is then solved for and
-                          [motion.gap] gives only hc(0)
-    [motion] mass = m     optional: a free indenter, m hc'' = int p dA - force(t), with
-                          force (a number or [motion.force] table) and hc_dot0
-    [domain]              L = 2.0
-    [run]                 method, t_end, dt, store_every, mesh, dr, dtheta_divisions,
-                          tol, operator ("auto" | "dense" | "fast"), operator_tol,
-                          max_wall (automatic mode: a time budget in seconds)
-
-Line contact (a rigid cylinder, gap x^2/2, on a Winkler foundation; see
-:mod:`femehl.problem.line`): ``[indenter] kind = "cylinder"`` needs ``[substrate]
-kind = "winkler"`` and gives a :class:`femehl.problem.line.LineScene` (k, beta, motion,
-L); its [run] takes method = "line", n_elements, grading ("uniform" or a size
-ratio >= 1), scheme, t_end, dt, store_every, tol, max_wall.  See
-``examples/cylinder_winkler.toml``.  A user gap profile (``LineScene(profile=...)``, a
-Python function) exists only in Python.
-
-A height map file is an ``.npz`` with arrays x, y, z (``np.savez``), its path
-relative to the scene file; so is a [run] mesh that is not a ladder name
-(coarse, medium, fine, xfine) or an absolute path.  ``kind = "shape"`` (a Python function) exists
-only in Python.
-
-Alternatively a ``[si]`` table (R, G, eta, V_ss, h_inf, nu, h0 [, t1, T, L,
-load, alpha (Barus, 1/Pa) or roelands_Z (Roelands, with eta as eta0), layer_thickness
-(m: a bonded elastic layer of that thickness on a rigid base, with the [si] nu), G0 and
-tau (Pa, s: a viscoelastic standard linear solid; optional G_inf, Pa, default G), mass,
-force, hc_dot0 (kg, N, m/s: a free indenter starting at h0 with that dhc/dt), sliding
-(false: no sliding, V = 0; V_ss then only sets the time scale), cavitation (as in
-[fluid])]) states the
-paper's experiment in SI units and replaces the tables above, except ``[indenter]``,
-which may then give an analytic shape in metres (R of [si] is the normalizing radius
-of curvature; ``load`` [N] imposes a constant load instead of the gap ramp).  ``femehl run`` then also writes
-``summary_si.csv``.  See ``examples/sphere_si.toml``.
-Every problem raises :class:`~femehl.errors.SceneFileError` naming the file
-and the key to fix.
+:func:`load_scene_file` reads one into a scene and its run options.  Each table names a
+*kind* looked up in a registry, never an if/elif chain: add a shape, substrate or time
+function by adding it to the registry.  The format, the line-contact and ``[si]`` tables:
+docs/scene.md ("Scene files (TOML)"); a commented example is ``examples/paper_sphere.toml``.
+Every problem raises :class:`~femehl.errors.SceneFileError` naming the file and the key
+to fix.
 """
 
 from __future__ import annotations

@@ -1,45 +1,11 @@
 """Friction force and energy budget of a sliding lubricated contact, from a State's fields.
 
-Physics (physical units; docs/design.md section 1): the indenter is at rest in its frame,
-the substrate's surface moves at ``-U`` along x, the film ``d = H - W`` lies between the
-substrate's surface ``z = W`` and the indenter's ``z = H``.  Lubrication theory gives the
-force the film exerts on the indenter along x, whose opposite is the friction force::
-
-    f = int [ eta U / d  +  (d/2) dp/dx  +  p dH/dx ] dA
-      = int [ eta U / d  -  (W + d/2) dp/dx ] dA              (by parts, p = 0 on the rim)
-
-(Couette shear, Poiseuille shear, and the pressure acting on the inclined indenter), and
-the energy balance ``f U = D_film + P_solid + d/dt(stored energy)`` with the film's
-viscous dissipation and the power the pressure delivers to the substrate's surface::
-
-    D_film  = int [ eta U^2 / d  +  d^3 |grad p|^2 / (12 eta) ] dA,
-    P_solid = int p (-DW/Dt) dA,     D/Dt = d/dt - U d/dx (the material moves at -U).
-
-Normalized (section 2 of the design: lengths sqrt(R h_inf), films h_inf, pressures
-``p0 = 4 pi G sqrt(h_inf/R)``, time ``2 sqrt(R h_inf)/V_ss``), with forces in units of
-``f0 = p0 h_inf sqrt(R h_inf)`` and powers in units of ``f0 V_ss``::
-
-    f       = int [ V/(6 beta d)  -  (W + d/2) dp/dx ] dA,
-    D_film  = int [ V^2/(6 beta d)  +  (beta/2) d^3 |grad p|^2 ] dA,
-    P_solid = (1/2) int p (-dW/dt + 2 V dW/dx) dA.
-
-The friction coefficient is ``mu = (f / load) sqrt(h_inf / R)`` (the load's unit is
-``p0 R h_inf``).  Here ``P_solid`` is reported for fields steady in the indenter's frame,
-``P_sliding = V int p dW/dx dA = -V int W dp/dx dA``: in steady sliding it is the rate of
-viscoelastic dissipation in the substrate (zero for an elastic one, whose operator is
-symmetric), and the balance reads ``f V = D_film + P_sliding``.  In a transient it
-omits ``-(1/2) int p dW/dt``, the rate of change of the stored elastic energy.
-
-A free indenter (``m hc'' = load - force`` in femehl's units) has the collision budget::
-
-    (1/2) m hc'^2 + force hc + E_el + int 2 D_film dt = const,   E_el = (1/2) int p (-W) dA,
-
-the factor 2 because the powers above are in units of ``f0 V_ss``, twice the unit
-``load h_inf / time`` of Newton's law (with the film's Reynolds equation this is an
-identity of the continuous problem, so the discrete budget measures the time error).
-
-On a half disk every integrand is even in y and the integrals are doubled.  The same
-formulas hold per unit length for line contact in its normalized units.
+The friction force ``f = int [V/(6 beta d) - (W + d/2) dp/dx] dA``, the film's viscous
+dissipation, the sliding power into the substrate (its viscoelastic dissipation in steady
+sliding: ``f V = D_film + P_sliding``) and a free indenter's collision budget, in
+normalized units (half disks doubled; per unit length for line contact).  The derivation
+in physical units, the normalization and the friction coefficient: docs/design.md
+section 15 ("The friction force and the energy budget").
 """
 
 from __future__ import annotations
@@ -83,7 +49,7 @@ def sliding_energetics(disc, state, beta: float) -> dict:
     dict
         ``friction`` (= ``shear_couette + shear_poiseuille + pressure_drag``), its three
         parts, ``dissipation_film``, ``power_sliding`` and ``elastic_energy``, normalized as
-        in the module docstring.
+        in docs/design.md section 15.
     """
     grad = getattr(disc, "pressure_gradient", None)
     if grad is None:

@@ -1,56 +1,12 @@
 """Linear solvers of the one linear system per step, with their state explicit.
 
-Every step of every method solves ``A p = b`` with
-
-    A = D + G C,        D sparse (n x n, the Poiseuille term),
-                        G = sum_i c_i F_i  sparse (n x film points: squeeze, Couette, ...),
-                        C the substrate's compliance (film points x n, dense or sparse),
-
-described by a :class:`StepOperator`.  The fixed products ``F_i C`` are formed once by
-the stepper, so a dense ``A`` costs one pass over memory and ``A z`` needs ONE dense
-product (``C z``) plus sparse work.
-
-Solvers are registered in :data:`LINEAR_SOLVERS` by name:
-
-``"lu"``
-    The paper's direct solve: a new LU of ``A`` every step (dense LAPACK, or SuperLU when
-    ``C`` is sparse), shared by the right-hand sides of the step.
-``"gmres"``
-    Minimal residual (GCR, equivalent to flexible GMRES) first over *recycled* directions
-    -- the last solutions and the last steps' search directions, kept with their ``C z``
-    -- and then over new directions ``z = LU^{-1} r`` with the single-precision LU of a
-    recent ``A`` as the preconditioner (one triangular-solve pair + one dense ``C``
-    product each).  The TRUE residual ``b - A x`` is checked before a solution is
-    accepted (sparse work, from the tracked ``C x``); otherwise the system is solved
-    directly.  The tracked ``C x`` (a combination of recycled ``C z``, never formed)
-    inherits their rounding generation after generation; two fixed random probes check
-    it to 1e-7 at the cost of two dot products, and it is formed when it fails (with the
-    fast operator: every 8 generations).  The LU is refreshed by cost balancing: when
-    the preconditioned iterations of the last solve cost more than the average cost per
-    solve since the last factorization (factorization included), or when ``c_0 = a0/dt``
-    fell below half the factorized one (:data:`KEY_CHANGE`).  ``refactor_after=n``
-    instead refreshes when a solve needed more than ``n`` preconditioned iterations.
-    With the *fast* operator (:mod:`femehl.elastic.hmatrix`, ``C`` never formed) the products
-    ``C z`` are hierarchical and the preconditioner is the sparse LU (SuperLU, in a
-    METIS nested-dissection order) of ``D + G C_near``, ``C_near`` the exact near field
-    within a few element sizes (:attr:`femehl.elastic.hmatrix.FastCompliance.preconditioner`),
-    after a coarse Galerkin correction on a coarse P1 space that carries the smooth far
-    field the near field misses (:class:`TwoLevel`, :mod:`femehl.elastic.coarse`: paper case
-    on 27,640 elements, 6.0 -> 1.85 iterations per step);
-    there is no direct fallback (a solve that does not converge raises).  ``rtol`` is
-    the relative residual ``||b - A x|| / ||b||``: default 1e-8 with the dense operator
-    (over the whole paper case that moves the films by < 4e-6 relative to a direct
-    solve, 1.9e-6 measured on the 2,988-element fitted mesh, three orders below the
-    finest discretization error) and 1e-9 with the fast one, whose sparse preconditioner
-    leaves a larger error for the same residual (5.5e-6 at 1e-8, 8e-7 at 1e-9 on that
-    mesh).  Both are relative to the films the step starts from: where the thinnest film
-    is below 1 % of the largest deflection the residual is tightened in proportion
-    (:func:`film_rtol_scale`, down to 1e-3 times), since the solve's error moves the film
-    by about ``rtol`` times the deflection, whatever the film.  With a sparse ``C``
-    (Winkler, rigid) there is no dense product to save and it solves directly.
-
-All state (the factor, the recycled directions, the cost of one iteration, counters in
-:attr:`info`) lives on the solver instance; a solver serves one stepper.
+Every step of every method solves ``A p = b``, ``A = D + G C`` (:class:`StepOperator`:
+``D`` sparse, ``G`` the sparse sum of the terms' film operators, ``C`` the substrate's
+compliance).  The solvers are registered in :data:`LINEAR_SOLVERS`: ``"lu"`` (a direct LU
+every step) and ``"gmres"`` (recycled GCR preconditioned by a refreshed LU; with the fast
+operator the near field's sparse LU after the coarse correction :class:`TwoLevel`).  All
+state lives on the solver instance; a solver serves one stepper.  The solvers, their
+refresh rules and tolerances: docs/design.md section 3.2 (and sections 9-10).
 """
 
 from __future__ import annotations
@@ -619,7 +575,7 @@ def film_rtol_scale(d, w) -> float:
 
 @register_linear_solver("gmres")
 class RecycledGCR:
-    """Recycled, LU-preconditioned minimal residual (see the module docstring).
+    """Recycled, LU-preconditioned minimal residual (docs/design.md section 3.2).
 
     Parameters
     ----------

@@ -1,60 +1,12 @@
 """Parameter studies on a Dask cluster: a base scene, a grid of parameters, one tidy table.
 
-A *sweep* is a base scene (a TOML scene file, its content as a dict, a
-:class:`~femehl.problem.scene.Scene`, or the built-in paper case), a set of parameter values
-(a full grid, a list of cases, or a random sample) over dotted scene fields, and the
-run options (``tol``, ``t_end``, ``method``, ...).  Each case is a plain femehl run
-(:func:`femehl.api.run_to_folder`) in its own folder ``OUT/cases/<key>``, ``key`` the
-content hash of the case's scene and options (:func:`case_key`), so
-
-* re-running a sweep skips every case already finished (its ``case.json`` is there),
-  and an interrupted sweep resumes where it stopped;
-* two sweeps that share a case compute it once.
-
-The cases run on ``dask.distributed``: by default a ``LocalCluster`` on this machine
-(one worker process per core, one thread each; the Dask nanny pins BLAS to one thread,
-``distributed.nanny.pre-spawn-environ``), or an existing cluster by its scheduler
-address (a workstation, an HPC allocation started with dask-jobqueue, a cloud
-cluster), unchanged.  A case that fails (FilmRuptureError, a bad combination) is
-recorded with its error and the others go on; a case whose worker dies is rescheduled
-by Dask on another worker (``distributed.scheduler.allowed-failures`` times) and then
-recorded as failed, never lost.
-
-The results are one table, ``OUT/results.parquet`` (Parquet: one row per case and
-stored time, the parameters as columns, the headline quantities with their estimated
-errors, wall time, status; columnar, typed, read by pandas, polars, DuckDB or Spark
-without femehl), rewritten atomically at the end of each sweep run.  ``OUT/sweep.json``
-records the sweep; another sweep is refused in the same folder unless
-``overwrite=True`` (its table is replaced; the case folders stay and are reused).
-
-Dotted names address the scene file's tables: ``fluid.beta``, ``indenter.Rx``,
-``motion.load`` (a number: a constant imposed load), ``motion.velocity.V_ss``,
-``domain.L``, ``si.V_ss`` (a scene stated in SI units), or a whole table
-(``indenter = {kind = "ellipsoid", Rx = 1, Ry = 2}``).  With a Scene object the names
-are its dataclass fields (``fluid.beta``, ``indenter.Rx``, ``domain.L``).  The run
-options are ``run.<option>`` (``run.tol``) or the sweep's ``[run]`` table.
-
-Sweep file (``femehl sweep SWEEP.toml``)::
-
-    [sweep]
-    scene = "../examples/paper_sphere.toml"   # relative to this file; default: paper case
-    out = "femehl-out/sweeps/beta"            # default: femehl-out/sweeps/<file name>
-    # max_cases = 20000                       # default MAX_CASES (counted before expanding)
-
-    [grid]                                    # every combination (or [[cases]], [sample])
-    "fluid.beta" = { logspace = [20, 20000], num = 12 }
-    indenter = [ { kind = "sphere", R = 1.0 }, { kind = "ellipsoid", Rx = 1.0, Ry = 2.0 } ]
-
-    [run]                                     # options of every case
-    t_end = 8.0
-
-    [cluster]                                 # optional: scheduler = "tcp://host:8786",
-    workers = 2                               #   memory_limit = "4GiB"
-
-Before the cluster starts, the file's value types, the number of cases and every
-case's scene and run options are checked (:func:`check_case_options`,
-:func:`check_cluster`); a sweep with cases that can't run is refused, and the message
-names them.
+:func:`sweep` (``femehl sweep SWEEP.toml``) runs each case of a grid, a list or a random
+sample over dotted scene fields as a plain femehl run in its own folder ``OUT/cases/<key>``
+(:func:`case_key`: finished cases are skipped, shared ones computed once) on
+``dask.distributed`` (a local cluster or any scheduler) and writes one table,
+``OUT/results.parquet``.  A failed case is recorded, never lost; every case is checked
+before the cluster starts.  The sweep file, the dotted names, the folders and the checks:
+docs/sweeps.md.
 """
 
 from __future__ import annotations
@@ -528,7 +480,7 @@ def _show(params: dict) -> str:
 
 
 def load_sweep_file(path) -> SweepPlan:
-    """A :class:`SweepPlan` from a sweep TOML file (see the module docstring)."""
+    """A :class:`SweepPlan` from a sweep TOML file (its format: docs/sweeps.md)."""
     from femehl.problem.scenefile import tomllib
 
     path = pathlib.Path(path)

@@ -1,136 +1,10 @@
-"""Exact steady sliding with mass-conserving (JFO) cavitation: line contact, any rigid gap.
+"""Exact steady sliding of line contact: the one steady line reference (any rigid gap, rigid or Winkler).
 
-Independent of the FE solver of :mod:`femehl.problem.line` and of :mod:`femehl.problem.cavitation`:
-quadrature and shooting, as :mod:`femehl.reference.line_steady` (which it reproduces without
-cavitation on the cylinder).  It is the reference the transient ``cavitation="jfo"``
-solver is validated against, with the Reynolds (Swift-Stieber) solution of the same
-slider beside it.
-
-The problem
------------
-The normalized line-contact equation of :mod:`femehl.problem.line`, at steady state
-(dd/dt = 0, V > 0 constant, hc imposed):
-
-    beta (d^3 p')' = -V (theta d)'   on -L < x < L,   p(-L) = p(L) = 0,        (1)
-    d = hc + s(x) + p/k                (Winkler; k = inf: rigid, d = hc + s)   (2)
-
-with ``s(x)`` the slider's rigid gap (default the cylinder ``x^2/2``).  The substrate
-moves toward -x, so the liquid is carried toward -x: the inlet is ``x = +L`` (fully
-flooded, ``theta = 1``), the outlet ``x = -L``.  JFO (Jakobsson-Floberg-Olsson,
-Elrod-Adams) complementarity:
-
-    p >= 0,   0 <= theta <= 1,   p (1 - theta) = 0.                            (3)
-
-The mass flux per unit width (positive toward +x) is
-
-    J = -beta d^3 p' - V theta d,                                              (4)
-
-and (1) says ``J' = 0``: at steady state J is ONE constant over the whole film, full
-and cavitated.  Write ``J = -V q`` (``q > 0``: the film thickness of the flux, the
-``d_*`` of :mod:`femehl.reference.line_steady`).  Then
-
-* in a full region (theta = 1):  ``beta d^3 p' = -(J + V d) = V (q - d)``, i.e.
-
-      p' = V (q - d) / (beta d^3),      d = hc + s(x) + p/k;                   (5)
-
-  a first-order ODE for p (for k = inf a quadrature: d is known);
-* in a cavity (p = 0): the liquid content ``c = theta d`` is carried at speed -V, so
-  ``c = q`` and ``theta = q / (hc + s(x))``, which must be <= 1: ``hc + s >= q``;
-* rupture (full -> cavity, in the flow direction, i.e. toward -x) at ``x_r``:
-  ``p = 0`` and ``p' = 0`` (theta = 1 on both sides, the flux continuous), so by (5)
-  ``d(x_r) = hc + s(x_r) = q``;                                                (6)
-* reformation (cavity -> full) at ``x_f``: ``p = 0`` and the flux continuous,
-  ``-beta d^3 p'(x_f) - V d(x_f) = -V q``: this is (5) at ``x_f`` with the SAME q,
-  so ``p'(x_f) = V (q - d_f)/(beta d_f^3) != 0``: theta jumps from ``q/d_f`` to 1. (7)
-
-The Reynolds (Swift-Stieber) condition
---------------------------------------
-``p >= 0`` with the Reynolds equation where ``p > 0`` and its residual >= 0 where
-``p = 0`` (the complementarity :class:`femehl.problem.cavitation.ReynoldsCavitation`
-imposes; an obstacle problem).  Its solution is C^1, so ``p = p' = 0`` at EVERY free
-boundary, rupture and reformation alike, and each full region has its own flux:
-the flux jumps at reformation (mass is created, ``V (q_2 - q)`` per unit time,
-:attr:`SteadyJFO.mass_source`).  The film content of a Reynolds cavity is not part of
-the model; :attr:`SteadyJFO.theta` reports there the content carried from the
-rupture, ``q / d``, so that the jump of (4) at reformation is that source.  A
-Reynolds reformation point is a point of (6) for the downstream flux ``q_2``, and
-lies where the gap still diverges (``s' <= 0``), upstream of the JFO one.
-
-The method
-----------
-Every full region is integrated toward +x, from its downstream end to its upstream
-end: for a Winkler film that is the stable direction of (5) (its linearization
-decays toward +x wherever ``d < 1.5 q``, see :mod:`femehl.reference.line_steady`).  Going
-against the flow, the regions are found in turn; all root finding is
-:func:`scipy.optimize.brentq` on smooth functions with tight tolerances:
-
-1. Full film (no cavity, case "full"): (5) from ``x = -L`` (p = 0) to ``+L``,
-   shooting on q until ``p(L) = 0``.  If that p is >= 0 everywhere it is the JFO
-   (and Reynolds) solution: JFO = Reynolds = full Sommerfeld.
-2. Otherwise the inlet region ``[x_r, L]`` ends at a rupture: for a trial ``x_r``,
-   (6) gives ``q = hc + s(x_r)`` and (5) is integrated from ``x_r`` (p = p' = 0)
-   toward +L; ``x_r`` is tuned until ``p(L) = 0`` with ``p > 0`` in between (a coarse
-   scan of ``x_r`` brackets it; the candidate nearest the inlet comes first).  The
-   inlet region, hence q and J, is the same for JFO and Reynolds.
-3. JFO, downstream of ``x_r`` (q known, no more shooting): start at ``x = -L``.  If
-   ``hc + s(-L) >= q`` the outlet is cavitated, else a full region starts there with
-   p = 0.  A full region is integrated toward +x until p comes back to 0: a
-   reformation point (7).  A cavity goes on (toward +x) until ``hc + s = q``: a
-   rupture (6), where a full region starts with p = p' = 0 -- unless that point is
-   ``x_r`` itself, and the march ends ("outlet-cavity": rupture only; "reformation":
-   rupture and reformation inside the domain).
-4. Reynolds, downstream of ``x_r``: the region adjacent to ``-L`` (if the outlet is
-   not cavitated) has its own flux ``q_2``, found by shooting from ``-L`` until the
-   local minimum of p after its maximum (``d = q_2``, (6)) is exactly 0; that point is
-   the reformation.  One cavity at most is handled for Reynolds.
-
-Integrators: :func:`scipy.integrate.solve_ivp` with DOP853 (explicit, order 8) at
-``rtol`` (default 1e-12): for a rigid slider (5) is a quadrature, and a Winkler film is
-only mildly stiff at such tolerances (its decay rate ``V/(beta k d^3)`` times the step
-stays in DOP853's stability region; ``method="Radau"`` for a much stiffer film, at a
-higher cost).  The load ``int p dx`` is a second component of the same ODE, the free
-boundaries are terminal events of the integration, and the integration is split at the
-profile's ``kinks`` (where s'' jumps, e.g. the edges of a cosine-squared pocket).  Each
-shooting root is bracketed at ``rtol = 1e-6`` and polished at ``rtol``.  The
-solution's own numerical error, :attr:`SteadyJFO.uncertainty`, is the change of every
-reported number when the whole solution is redone at a 100 times looser ``rtol``
-(measured: halving ``rtol`` changes the results by < 1e-11).
-
-Reference configurations (``V = 1, L = 2``; numbers at ``rtol = 1e-12``, their own
-uncertainty <= 2e-9; ``tests/test_line_jfo_reference.py`` pins those of "c1")
----------------------------------------------------------------------------------------
-* "outlet-cavity" (rupture only; JFO and Reynolds coincide):
-
-  - b1, the Winkler cylinder of ``tests/test_line.py`` (``s = x^2/2, k = 1, beta = 10,
-    hc = -0.5``; the steady state of the default :class:`femehl.problem.line.LineScene`):
-    rupture at x = -1.13900511824033, J = -0.148666329688834, load 1.05905170804220,
-    minimum film 0.126852581890131 at x = -1.06864;
-  - b2, the rigid cylinder (``k = inf, beta = 1, hc = 0.1``): rupture at
-    x = -0.210847583262465, J = -0.122228351683811, load 3.62837155510199, minimum
-    film 0.1 at x = 0.
-
-* "reformation" (rupture and reformation inside the domain), the slider of
-  :func:`pocket_slider` with its defaults (flat land from the outlet to x = 1, a
-  blended ramp to 0.2 (x - 1.25) toward the inlet, a pocket 0.3 deep (3 films) and 1
-  wide centred at x = -1), ``hc = 0.1``.  The film ruptures entering the pocket,
-  reforms inside it, and the pressure builds up again on the land downstream:
-
-  - c1, rigid, ``beta = 1``: rupture at x = -0.542391715898412, JFO reformation at
-    x = -1.16438139423915 (the pocket's converging half), J = -0.105289491061097,
-    load 12.6652545403082; Reynolds reformation at x = -0.563752778842461 (still in
-    the diverging half), outlet flux -0.111874199219468, load 16.1588612912422;
-    minimum film 0.1 at the outlet;
-  - c2, Winkler ``k = 100, beta = 10`` (a LineScene the FE solver runs directly:
-    ``LineScene(k=100, beta=10, profile=pocket_slider()[0], motion=Motion(gap=0.1,
-    velocity=TanhStart(1, 1)))``): rupture at x = -0.560838936849026, JFO reformation
-    at x = -0.828017184370354, J = -0.110826531820442, load 1.51139560116832;
-    Reynolds reformation at x = -0.573564147211335, outlet flux -0.115740101803692,
-    load 1.72281455904992.
-
-Use: ``s = steady_jfo(profile, hc, V=1.0, beta=10.0, k=100.0, L=2.0, kinks=kinks)``;
-``s.x, s.p, s.theta, s.d`` on the points, ``s.pressure(x)`` etc. anywhere,
-``s.rupture, s.reformation, s.J, s.load, s.film_min, s.uncertainty``.  A
-:class:`femehl.problem.line.LineScene`'s ``shape`` is a valid ``profile``.
+Full film (:func:`steady_full_film`), mass-conserving JFO (:func:`steady_jfo`) or Reynolds
+(:func:`steady_reynolds`) cavitation, by quadrature and shooting in the pressure, independent of
+the FE solver of :mod:`femehl.problem.line`; :mod:`femehl.reference.line_steady` presents its
+cylinder case.  The equations (numbered (1)-(7) in the docstrings), the method, the reference
+configurations and the independent checks: docs/design.md section 17.
 """
 
 from __future__ import annotations
@@ -184,7 +58,7 @@ def pocket_slider(
     flat from the outlet to ``ramp_start``, then rising toward the inlet +L
     (converging in the flow direction); ``blend = 0`` is a sharp corner, and
     ``ramp_start <= -L`` a plain linear slider.  The pocket and the blended ramp are C^1.
-    The default is the "reformation" reference geometry of the module docstring (with
+    The default is the "reformation" reference geometry of docs/design.md section 17.5 (with
     ``hc = 0.1``: film 0.1 on the land, pocket 3 films deep, 0.25 at the inlet).
 
     Returns
@@ -377,6 +251,11 @@ class _Piecewise:
         return out
 
 
+#: the default integrator is Radau when ``2 L V / (beta k max(hc + s)^3)``, an estimate of (5)'s
+#: decay rate times the domain's length, exceeds this (a film soft everywhere; design.md 17.3)
+_SOFT = 300.0
+
+
 class _Problem:
     """Profile, parameters and the integrator of (5) toward +x."""
 
@@ -385,9 +264,12 @@ class _Problem:
         self.rigid = math.isinf(k)
         self.kinks = np.array(sorted(float(c) for c in kinks if -L < c < L))
         self.rtol = rtol
-        self.method = method or "DOP853"
         xs = np.linspace(-L, L, 4001)
         self.grid, self.h_grid = xs, hc + self._s(xs)
+        if method is None:  # Radau where DOP853 is held to tiny steps by stability alone
+            soft = not self.rigid and 2.0 * L * V / (beta * k * float(self.h_grid.max()) ** 3) > _SOFT
+            method = "Radau" if soft else "DOP853"
+        self.method = method
 
     def _s(self, x):
         return np.asarray(self.profile(np.asarray(x, dtype=float)), dtype=float)
@@ -891,7 +773,8 @@ _COMMON = """
     rtol : float, default: 1e-12
         Relative tolerance of the integrations (the root finding goes to machine precision).
     method : str, optional
-        :func:`scipy.integrate.solve_ivp` method (DOP853, Radau, BDF, RK45); default DOP853.
+        :func:`scipy.integrate.solve_ivp` method (DOP853, Radau, BDF, RK45); default DOP853, or
+        Radau for a Winkler film soft everywhere (``2 L V / (beta k max(hc + s)^3) > 300``).
     estimate_error : bool, default: True
         Solve again at ``100 rtol`` and report the differences as ``uncertainty``.
 
@@ -958,7 +841,7 @@ def steady_full_film(
 steady_jfo.__doc__ = (
     """Steady sliding with JFO (mass-conserving) cavitation: exact, by quadrature and shooting.
 
-    The flux (4) is one constant; free boundaries by (6) and (7) (module docstring).
+    The flux (4) is one constant; free boundaries by (6) and (7) (docs/design.md section 17).
     No cavity (case "full"), one cavity open to the outlet ("outlet-cavity") or cavities
     with reformation inside the domain ("reformation") are found automatically.
 """
@@ -975,7 +858,8 @@ steady_reynolds.__doc__ = (
 steady_full_film.__doc__ = (
     """Steady sliding without a cavitation condition (full Sommerfeld: p may be < 0).
 
-    On the cylinder this is :func:`femehl.reference.line_steady.steady_line`'s problem.
+    On the cylinder (``profile=None``) :func:`femehl.reference.line_steady.steady_line` presents it
+    in the names of the paper's section 4.
 """
     + _COMMON
 )

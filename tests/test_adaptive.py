@@ -21,7 +21,7 @@ from femehl.api import make_stepper, run_loop, solve
 from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
 from femehl.problem.line import LineScene
 from femehl.solver.adaptive import AdaptiveSteps, StepController
-from femehl.solver.stepping import SCHEMES, FixedSteps, State, film_positive, march
+from femehl.solver.stepping import SCHEMES, FixedSteps, GivenSteps, State, film_positive, march
 
 
 # ---- a scalar ODE with a known solution ---------------------------------------------------
@@ -361,3 +361,16 @@ def test_the_one_loop_walks_any_step_policy():
     ts = [s.t for s in march(ode, 1.0, Doubling())]
     assert ts == pytest.approx([0.0, 0.01, 0.03, 0.07, 0.15, 0.31, 0.63, 1.0])
     assert ode.solves == len(ts) - 1
+
+
+def test_given_steps_replay_an_adaptive_run_exactly():
+    # the same stepper walked on an adaptive run's own times (breakpoint restarts included)
+    # gives that run's states (to round-off: a step is t_new - t there, h here), so a
+    # companion on the same steps differs from the run in space only
+    first = _run(ScalarODE(), 6.0, tol=1e-3)
+    again = list(march(ScalarODE(), 6.0, GivenSteps([s.t for s in first[1:]])))
+    assert [s.t for s in again] == [s.t for s in first]
+    assert np.allclose([s.d[0] for s in again], [s.d[0] for s in first], rtol=1e-13, atol=0.0)
+    for bad in ([], [0.2, 0.1], [0.1, math.nan]):
+        with pytest.raises(SceneError, match="increasing"):
+            GivenSteps(bad)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from femehl.errors import FilmRuptureError, SceneError, SolverError
-from femehl.solver.stepping import State, film_floor, film_positive
+from femehl.solver.stepping import State, _restart, breakpoints_of, film_floor, film_positive
 from femehl.validation import check_positive
 
 __all__ = ["AdaptiveSteps", "StepController", "breakpoints_of", "CONTROLS"]
@@ -104,12 +104,6 @@ class _Failure:
 
 
 # ---- helpers ------------------------------------------------------------------------------
-def breakpoints_of(scene) -> tuple:
-    """The motion's breakpoints (:attr:`femehl.problem.scene.Motion.breakpoints`), () if it has none."""
-    motion = getattr(scene, "motion", None)
-    return tuple(getattr(motion, "breakpoints", ()) or ())
-
-
 def _order(stepper) -> int:
     return int(getattr(getattr(stepper, "scheme", None), "order", 2))
 
@@ -118,11 +112,6 @@ def _tag(state: State, dt: float, err: float, rejected: int) -> State:
     info = dict(state.info)
     info.update(dt=float(dt), error_estimate=float(err), rejected=int(rejected))
     return dataclasses.replace(state, info=info)
-
-
-def _restart(state: State) -> State:
-    """``state`` without its history: the next step is a backward-Euler (start) step."""
-    return dataclasses.replace(state, d_prev=None, dt_prev=None)
 
 
 def _lagrange(ts, t) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 A *stepper* (:class:`femehl.solver.stepper.LaggedStepper`, the same for every method)
 builds its operators once and advances one step (ONE linear solve, docs/design.md
-section 3); a step policy (:class:`FixedSteps`, or
+section 3); a step policy (:class:`FixedSteps`, :class:`GivenSteps`, or
 :class:`femehl.solver.adaptive.AdaptiveSteps`) chooses the steps; ``march`` yields the
 initial state and then every accepted state, so a caller can stop, store or plot whenever
 it likes.
@@ -25,6 +25,8 @@ __all__ = [
     "Stepper",
     "march",
     "FixedSteps",
+    "GivenSteps",
+    "breakpoints_of",
     "check_run",
     "Scheme",
     "SCHEMES",
@@ -164,6 +166,60 @@ class FixedSteps:
         self._k += 1
         self._last = trial
         yield trial
+
+
+class GivenSteps:
+    """The step policy that lands on given ``times`` (e.g. another run's, so that two
+    discretizations are compared at the same steps), then on ``t_end``.  As adaptive steps
+    do, the history is dropped at the motion's breakpoints and at ``start`` (a backward-Euler
+    step follows); a step that fails raises."""
+
+    def __init__(self, times):
+        ts = np.asarray(times, dtype=float).ravel()
+        if ts.size == 0 or not np.all(np.isfinite(ts)) or np.any(np.diff(ts) <= 0.0):
+            raise SceneError("times must be a non-empty increasing sequence of finite times.")
+        self.times = ts
+
+    def begin(self, stepper: Stepper, t_end: float, start: State | None) -> State:
+        from femehl.validation import check_positive
+
+        t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
+        state = stepper.initial_state() if start is None else _restart(start)
+        if t_end <= state.t:
+            raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
+        eps = 1e-12 * max(1.0, abs(t_end))
+        self._stops = [float(t) for t in self.times if state.t + eps < t < t_end - eps] + [t_end]
+        scene = getattr(stepper, "scene", None)
+        self._breaks = [b for b in breakpoints_of(scene) if state.t + eps < b < t_end - eps]
+        self._eps, self._last = eps, state
+        return state
+
+    def propose(self):
+        if not self._stops:
+            return None
+        base, t_new = self._last, self._stops[0]
+        if any(abs(base.t - b) <= self._eps for b in self._breaks):
+            base = _restart(base)
+        return base, t_new, t_new - base.t
+
+    def judge(self, trial: State | None, failure: Exception | None):
+        if failure is not None:
+            raise failure
+        _check_film(trial)
+        self._stops.pop(0)
+        self._last = trial
+        yield trial
+
+
+def breakpoints_of(scene) -> tuple:
+    """The motion's breakpoints (:attr:`femehl.problem.scene.Motion.breakpoints`), () if it has none."""
+    motion = getattr(scene, "motion", None)
+    return tuple(getattr(motion, "breakpoints", ()) or ())
+
+
+def _restart(state: State) -> State:
+    """``state`` without its history: the next step is a backward-Euler (start) step."""
+    return dataclasses.replace(state, d_prev=None, dt_prev=None)
 
 
 def march(stepper: Stepper, t_end: float, steps, start: State | None = None) -> Iterator[State]:

@@ -374,3 +374,12 @@ def test_given_steps_replay_an_adaptive_run_exactly():
     for bad in ([], [0.2, 0.1], [0.1, math.nan]):
         with pytest.raises(SceneError, match="increasing"):
             GivenSteps(bad)
+
+
+def test_run_loop_takes_a_step_policy_alone():
+    ode = ScalarODE()
+    res = run_loop(ode, 1.0, steps=GivenSteps([0.25, 0.5, 1.0]))
+    assert list(res.t) == [0.0, 0.25, 0.5, 1.0]
+    for kw in (dict(dt=0.1), dict(step_tol=1e-3), dict(dt_max=0.5)):
+        with pytest.raises(SceneError, match="whole step policy"):
+            run_loop(ScalarODE(), 1.0, steps=GivenSteps([1.0]), **kw)

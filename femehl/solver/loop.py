@@ -76,6 +76,7 @@ def run_loop(
     dt: float | None = None,
     *,
     step_tol: float | None = None,
+    steps=None,
     start: State | None = None,
     store_every: int = 1,
     on_state: Callable[[State], None] | None = None,
@@ -86,8 +87,9 @@ def run_loop(
     Every way of running femehl (``solve``, ``run_to_folder``, the CLI) goes through
     here.  The step policy: fixed steps ``dt`` (:class:`femehl.solver.stepping.FixedSteps`),
     or adaptive steps to ``step_tol`` (:class:`femehl.solver.adaptive.AdaptiveSteps`, ``dt``
-    the first step, ``controls`` its ``dt_min``, ``dt_max``, ``safety``), both walked by the
-    one time loop :func:`femehl.solver.stepping.march`.  ``start`` resumes from a State (its own
+    the first step, ``controls`` its ``dt_min``, ``dt_max``, ``safety``), or ``steps``, a
+    policy object (e.g. :class:`femehl.solver.stepping.GivenSteps`, another run's times), all
+    walked by the one time loop :func:`femehl.solver.stepping.march`.  ``start`` resumes from a State (its own
     record is kept, ``on_state`` is not called for it).  If the run stops on a
     :class:`~femehl.errors.SolverError` or is interrupted, the partial Result is attached
     to the exception as ``.result`` and the exception propagates; everything fed to
@@ -95,7 +97,13 @@ def run_loop(
     """
     if isinstance(store_every, bool) or not isinstance(store_every, int) or store_every < 0:
         raise SceneError(f"store_every must be an integer >= 0, got {store_every!r}.")
-    if step_tol is None:
+    if steps is not None:
+        if dt is not None or step_tol is not None or controls:
+            raise SceneError(
+                "steps= is the whole step policy: give no dt, step_tol or step controls with it."
+            )
+        policy = steps
+    elif step_tol is None:
         if controls:
             raise SceneError(f"{sorted(controls)} tune adaptive steps: give step_tol= as well.")
         policy = FixedSteps(0.01 if dt is None else dt)

@@ -11,6 +11,7 @@ import inspect
 import math
 import time
 from collections.abc import Callable
+from contextlib import nullcontext
 
 from femehl.errors import SceneError, SolverError
 from femehl.output.result import Result
@@ -172,41 +173,37 @@ def run_scene(
     """
     t0 = time.perf_counter()
     stepper = make_stepper(scene, method, **options)
-    if sink is None:
-        return _march(stepper, t_end, dt, None, step_tol, store_every, on_state, progress, label, controls)
-    with sink.writer(stepper, t_end, dt, step_tol, plan, t0) as writer:
-        if writer.done is not None:
+    writing = nullcontext() if sink is None else sink.writer(stepper, t_end, dt, step_tol, plan, t0)
+    with writing as writer:
+        if writer is not None and writer.done is not None:
             return writer.done
-        handler = chain([writer, on_state])
-        result = _march(
-            stepper, t_end, dt, writer.start, step_tol, store_every, handler, progress, label, controls
-        )
-        return writer.finished(result)
+        start = None if writer is None else writer.start
+        bar = _bar(progress, stepper, t_end, start, label)
+        try:
+            result = run_loop(
+                stepper,
+                t_end,
+                dt,
+                step_tol=step_tol,
+                start=start,
+                store_every=store_every,
+                on_state=chain([writer, on_state, bar]),
+                **controls,
+            )
+        finally:
+            if bar is not None:
+                bar.close()
+        return result if writer is None else writer.finished(result)
 
 
-def _march(stepper, t_end, dt, start, step_tol, store_every, on_state, progress, label, controls) -> Result:
-    """:func:`run_loop` with a progress handler when ``progress`` makes one."""
-    bar = None
-    if progress is not None:
-        cells = stepper.info.get("elements", "?") if hasattr(stepper, "info") else "?"
-        what = f"{label}, " if label else ""
-        bar = progress(
-            f"{stepper.method} ({what}{cells} cells)", t_end, 0.0 if start is None else float(start.t)
-        )
-    try:
-        return run_loop(
-            stepper,
-            t_end,
-            dt,
-            step_tol=step_tol,
-            start=start,
-            store_every=store_every,
-            on_state=chain([on_state, bar]),
-            **controls,
-        )
-    finally:
-        if bar is not None:
-            bar.close()
+def _bar(progress, stepper, t_end, start, label):
+    """The progress handler ``progress`` makes for this run (None without one)."""
+    if progress is None:
+        return None
+    cells = stepper.info.get("elements", "?") if hasattr(stepper, "info") else "?"
+    what = f"{label}, " if label else ""
+    t_start = 0.0 if start is None else float(start.t)
+    return progress(f"{stepper.method} ({what}{cells} cells)", t_end, t_start)
 
 
 def chain(handlers):

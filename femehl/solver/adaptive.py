@@ -289,7 +289,8 @@ class AdaptiveSteps:
     ----------
     tol : float
         Relative local error per unit time, in the norm of docs/design.md section 3.1 (0 < tol < 1);
-        the global error of load and films is then about tol or below.
+        the global error of load and films is then about 0.3 to 2 times tol (docs/design.md
+        section 3.1).
     dt0 : float, optional
         First step and the step after each breakpoint; default ``0.05 tol``.
     dt_min, dt_max : float, optional

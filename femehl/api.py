@@ -274,7 +274,7 @@ def _expert(
     )
     if not estimate or folder is not None and folder.resume or result.info.get("nothing_to_do"):
         return result  # a resumed run: no companion for its part only
-    companion, ratio = companion_run(scene, result.method, options, t_end, dt, step_tol, controls)
+    companion, ratio = companion_run(scene, result.method, options, result, dt, step_tol)
     result.estimate = expert_estimate(result, companion, ratio, adaptive=step_tol is not None)
     return result
 

@@ -252,23 +252,27 @@ def time_error(res: Result) -> np.ndarray:
     return np.cumsum(local)
 
 
-def companion_run(scene, method, options, t_end, dt, step_tol, controls) -> tuple:
-    """``(Result, ratio)`` of the coarser companion of an expert run, or ``(None, None)``.
+def companion_run(scene, method, options, run: Result, dt, step_tol) -> tuple:
+    """``(Result, ratio)`` of the coarser companion of an expert ``run``, or ``(None, None)``.
 
-    Same time steps as the run (fixed ``dt``, or adaptive to the same ``step_tol``), the
-    method's :attr:`Ladder.companion` discretization.  A companion that stops (its
-    coarser mesh may not resolve the film) is logged and gives no space estimate.
+    The method's :attr:`Ladder.companion` discretization on the run's own time steps: its
+    fixed ``dt``, or the times its adaptive steps (to ``step_tol``) took, replayed
+    (:class:`femehl.solver.stepping.GivenSteps`), so the two differ in space only.  A
+    companion that stops (its coarser mesh may not resolve the film) is logged and gives no
+    space estimate.
     """
     from femehl.solver.loop import make_stepper, run_loop
+    from femehl.solver.stepping import GivenSteps
 
     ladder = LADDERS.get(method)
     plan = ladder.companion(scene, options) if ladder is not None and ladder.companion else None
     if plan is None:
         return None, None
     coarse_options, ratio = plan
+    steps = {"dt": dt} if step_tol is None else {"steps": GivenSteps(run.t[1:])}
     try:
         coarse = make_stepper(scene, method, **coarse_options)
-        return run_loop(coarse, t_end, dt, step_tol=step_tol, store_every=0, **controls), ratio
+        return run_loop(coarse, float(run.t[-1]), store_every=0, **steps), ratio
     except SolverError as exc:
         logger.warning("femehl: no space estimate: the coarser companion run stopped (%s)", exc)
         return None, None
@@ -278,9 +282,9 @@ def expert_estimate(res: Result, companion: Result | None, ratio: float | None, 
     """The :class:`~femehl.accuracy.estimate.Estimate` of an expert run (its own mesh and steps).
 
     ``space``: the running maximum of ``|q - q_c| / (ratio**2 - 1)`` against a
-    ``companion`` run ``ratio`` times coarser in space with the same time steps (fixed
-    ``dt``, or the same tolerance), so the difference is the space error; None without a
-    companion.  ``time``: the controller's accumulated local errors (:func:`time_error`)
+    ``companion`` run ``ratio`` times coarser in space on the same time steps (fixed
+    ``dt``, or the adaptive run's own times replayed), so the difference is the space
+    error; None without a companion.  ``time``: the controller's accumulated local errors (:func:`time_error`)
     for adaptive steps, None for fixed steps.  ``total = space + time`` when both are
     known, else None.  None when neither is.
     """

@@ -118,6 +118,12 @@ class Ladder:
     #: ``sizer(scene, t_end) -> cells(level)``: :attr:`cells` with what does not depend on
     #: the level computed once (the budgets ask for many levels); default: :attr:`cells`
     sizer: Callable[..., Callable[[float], float]] | None = None
+    #: ``adapt(result, scene, t_end) -> Ladder``: a ladder of discretizations adapted to a
+    #: finished run (its meshes where that run's error is), or None: the method has none
+    adapt: Callable[..., Ladder] | None = None
+    #: how to rebuild this ladder when a run folder resumes a run made on it (JSON-able:
+    #: the plan records it), None for a registered ladder
+    record: dict | None = None
 
     def cells_of(self, scene, t_end: float) -> Callable[[float], float]:
         """``cells(level)`` of ``scene`` over a run to ``t_end``."""
@@ -159,6 +165,48 @@ def _fe_sizer(scene, t_end):
 LINE_ELEMENTS = 400
 
 
+#: the automatic sequence adapts its meshes to the run at this level (the second pilot)
+ADAPT_LEVEL = 2.0
+
+
+def _fe_adapt(result, scene, t_end) -> Ladder:
+    """The ladder of meshes adapted to ``result``, its level 1 as many cells as the fitted one's."""
+    from femehl.discretize.adapted import adapted_sizes
+
+    return adapted_ladder(adapted_sizes(result, _fe_sizer(scene, t_end)(1.0)))
+
+
+def adapted_ladder(sizes) -> Ladder:
+    """The FE ladder of :class:`femehl.discretize.adapted.AdaptedSizes` ``sizes`` (each
+    level's mesh built once)."""
+    meshes = {}
+
+    def options(scene, t_end, level):
+        key = float(level)
+        if key not in meshes:
+            meshes[key] = sizes.mesh(key)
+        return {"mesh": meshes[key]}
+
+    return Ladder(
+        options,
+        lambda scene, t_end, level: sizes.cells(level),
+        ("mesh", "half"),
+        sizer=lambda scene, t_end: sizes.cells,
+        record={"adapted": sizes.record()},
+    )
+
+
+def _ladder_of(method: str, plan: dict) -> Ladder:
+    """The ladder a resumed candidate was made on: adapted (its plan holds the sizes) or
+    the method's registered one, fitted to the first run's end ``t_fit``."""
+    if "adapted" in plan:
+        from femehl.discretize.adapted import AdaptedSizes
+
+        return adapted_ladder(AdaptedSizes.from_record(plan["adapted"]))
+    t_fit = float(plan.get("t_fit", plan["companion"]["t"][-1]))
+    return _fitted_to(LADDERS[method], t_fit)
+
+
 def _line_elements(level) -> int:
     return max(20, round(LINE_ELEMENTS / level))
 
@@ -187,7 +235,7 @@ def _line_companion(scene, options):
     return ({**options, "n_elements": n // 2}, n / (n // 2)) if n >= 40 else None
 
 
-register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion, _fe_sizer))
+register_ladder("fe", Ladder(_fe_options, _fe_cells, ("mesh", "half"), _fe_companion, _fe_sizer, _fe_adapt))
 register_ladder(
     "line",
     Ladder(
@@ -377,7 +425,7 @@ def _run(
     on_state = disc.pop("callback", None)
     controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
     if plan is None and previous is not None:
-        plan = _plan(tol, level, tol_t, t_end, previous)
+        plan = _plan(tol, level, tol_t, t_end, previous, ladder)
     sink = None if plan is None else folder
     if sink is None and deadline is not None:
         on_state = _deadline_guard(deadline, on_state)
@@ -409,7 +457,7 @@ def _run(
     return res
 
 
-def _plan(tol, level, tol_t, t_fit, previous) -> dict:
+def _plan(tol, level, tol_t, t_fit, previous, ladder) -> dict:
     """What a run folder records of a candidate run, to resume it (its checkpoint's ``auto``)."""
     return {
         "tol": tol,
@@ -417,6 +465,7 @@ def _plan(tol, level, tol_t, t_fit, previous) -> dict:
         "tol_t": tol_t,
         "t_fit": t_fit,
         "companion": companion_record(previous),
+        **(ladder.record or {}),
     }
 
 
@@ -426,12 +475,12 @@ def resume_to_tolerance(scene, folder, saved: dict, *, t_end, method, store_ever
     the budgets of the sequence no longer apply.  Extended past its companion's end, the
     companion runs again; the estimate goes on from the earlier part's
     (:meth:`~femehl.accuracy.estimate.Estimate.continued`)."""
-    t_fit = float(saved.get("t_fit", saved["companion"]["t"][-1]))
     kept = {k: v for k, v in options.items() if k not in ("max_wall", "max_elements")}
+    ladder = _ladder_of(method, saved)
     res = _run(
         scene,
         method,
-        _fitted_to(LADDERS[method], t_fit),
+        ladder,
         t_end,
         saved["level"],
         store_every,
@@ -449,7 +498,7 @@ def resume_to_tolerance(scene, folder, saved: dict, *, t_end, method, store_ever
         folder.say(
             f"femehl: the coarser companion (level {level_c:.3g}) again to t = {t_end:g} (the estimate)"
         )
-        companion = companion_to(scene, method, t_end, t_fit, level_c, store_every, kept)
+        companion = _run(scene, method, ladder, t_end, level_c, 0, dict(kept))
     est = estimate(res, companion, level_c / saved["level"])
     before = folder.earlier_estimate()
     res.estimate = est.continued(before) if before else est
@@ -460,12 +509,6 @@ def resume_to_tolerance(scene, folder, saved: dict, *, t_end, method, store_ever
 def _fitted_to(ladder: Ladder, t_fit: float) -> Ladder:
     """``ladder`` with its discretizations fitted to a run to ``t_fit`` whatever the run's end."""
     return Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
-
-
-def companion_to(scene, method, t_end, t_fit, level, store_every, options) -> Result:
-    """The companion run of a resumed automatic run again, to a later ``t_end``: ``level``'s
-    discretization fitted to ``t_fit`` (the first run's end, as the candidate's mesh)."""
-    return _run(scene, method, _fitted_to(LADDERS[method], t_fit), t_end, level, 0, dict(options))
 
 
 def _next_level(level: float, err: float, tol: float) -> float:
@@ -657,6 +700,8 @@ def solve_to_tolerance(
 
     runs, est, reached, err = [], None, False, math.nan
     fine, failed, last, stopped = None, None, False, None
+    family = 0  # runs[family:] are on the current ladder (a pair is made within it only)
+    adapted_at = None  # the level of the run the meshes were adapted to
     while True:
         ne = cells(level)
         over_cells = ne > max_elements
@@ -695,8 +740,9 @@ def solve_to_tolerance(
             # the cell budget's fit is the finest level there is; the time budget's is
             # asked again after the run (a run cheaper than predicted leaves time for more)
             level, last, stopped = fit, why == "cell budget", why
-        candidate = len(runs) >= MIN_RUNS - 1
+        candidate = len(runs) >= MIN_RUNS - 1 and len(runs) > family
         previous = runs[-1] if candidate else None
+        seed = ladder.adapt is not None and family == 0 and level <= ADAPT_LEVEL
         try:
             res = _run(
                 scene,
@@ -704,7 +750,7 @@ def solve_to_tolerance(
                 ladder,
                 t_end,
                 level,
-                store_every,
+                1 if seed else store_every,  # the run meshes are adapted to: all its states
                 options,
                 folder,
                 previous,
@@ -735,11 +781,13 @@ def solve_to_tolerance(
             failed = _closing_confirmed(failed, exc, level, t_end)
             level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
             continue
-        if runs:
+        if len(runs) > family:
             ratio = runs[-1].info["level"] / level
             est = estimate(res, runs[-1], ratio)
             err = est.worst()
             logger.info("auto: estimated error %.3g (%s), level ratio %.3g", err, est.where(), ratio)
+        else:
+            est, err = None, math.nan
         if fine is not None:
             fine._stored.clear()  # superseded: its scalars stay (the companion), its fields go
         fine = res
@@ -751,8 +799,31 @@ def solve_to_tolerance(
             break
         if last:
             break
-        level = _next_level(level, err, tol) if len(runs) >= 2 else level / 2.0
-    return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall)
+        if seed:  # from here on, meshes adapted to this run, from its level again
+            adapted = _adapted(ladder, res, scene, t_end)
+            if adapted is not None:
+                ladder, family, adapted_at = adapted, len(runs), level
+                cells = ladder.cells_of(scene, t_end)
+                continue
+        level = _next_level(level, err, tol) if len(runs) - family >= 2 else level / 2.0
+    return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall, adapted_at)
+
+
+def _adapted(ladder: Ladder, res: Result, scene, t_end: float) -> Ladder | None:
+    """The ladder adapted to ``res`` (None, logged, when the run gives nothing to adapt to)."""
+    from femehl.errors import FemehlError
+
+    try:
+        adapted = ladder.adapt(res, scene, t_end)
+    except FemehlError as exc:
+        logger.warning("auto: meshes not adapted (%s): the fitted meshes go on", exc)
+        return None
+    logger.info(
+        "auto: meshes adapted to the run at level %.3g (%d cells) from here on",
+        res.info["level"],
+        res.info["elements"],
+    )
+    return adapted
 
 
 #: two runs whose films close within this fraction of t_end of each other, and within
@@ -793,7 +864,7 @@ def _closing_confirmed(earlier, exc, level, t_end):
     return exc
 
 
-def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -> Result:
+def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None, adapted_at=None) -> Result:
     """Attach the estimate and the summary of the runs; warn when tol was not reached."""
     res.estimate = est
     info = {
@@ -808,6 +879,7 @@ def _finish(res: Result, est, runs, tol, reached, stopped=None, max_wall=None) -
         "rejected_steps": [r.info.get("rejected_steps") for r in runs],
         "tol_t": [r.info["tol_t"] for r in runs],
         "wall": [r.info["wall"] for r in runs],
+        "adapted_at": adapted_at,
     }
     if est is not None:
         info.update({part: est.worst(part) for part in ("total", "space", "time")})

@@ -799,7 +799,7 @@ def solve_to_tolerance(
             break
         if last:
             break
-        if seed:  # from here on, meshes adapted to this run, from its level again
+        if seed and not err <= ACCEPT * tol:  # from here on, meshes adapted to this run, from its level again
             adapted = _adapted(ladder, res, scene, t_end)
             if adapted is not None:
                 ladder, family, adapted_at = adapted, len(runs), level

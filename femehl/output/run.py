@@ -184,12 +184,17 @@ class RunFolder:
         """What the automatic sequence chose (nothing for an expert or resumed run)."""
         if "levels" not in a:
             return
+        at = a.get("adapted_at")
+        runs = [
+            f"level {lv:.3g}: {n} cells, {k} steps"
+            for lv, n, k in zip(a["levels"], a["elements"], a["steps"], strict=True)
+        ]
+        if at is not None:  # the runs after the one at that level are on meshes adapted to it
+            i = next(i for i, lv in enumerate(a["levels"]) if lv == at) + 1
+            runs[i] = f"then on meshes adapted to it, {runs[i]}"
         self.say(
             "femehl: chose "
-            + ", ".join(
-                f"level {lv:.3g}: {n} cells, {k} steps"
-                for lv, n, k in zip(a["levels"], a["elements"], a["steps"], strict=True)
-            )
+            + ", ".join(runs)
             + f"; estimated error {a.get('total', float('nan')):.2g} "
             + ("(tol reached" if a["reached"] else "(tol NOT reached")
             + f": accepted at <= {a['accept']:g} tol)"

@@ -666,28 +666,12 @@ def solve_to_tolerance(
     ``folder`` (a :class:`~femehl.output.run.RunFolder`) is fed each run that may be the
     answer (the pilots stay in memory; a finer candidate replaces the coarser one's files).
     """
-    from femehl.solver.loop import _registry
-
-    method = scene.default_method if method is None else method
-    if method not in LADDERS:
-        known = sorted(_registry())
-        raise SceneError(
-            f"method {method!r} has no refinement ladder, so it cannot choose its own "
-            f"discretization; automatic methods: {sorted(LADDERS)} (all: {known}). "
-            "Give its discretization options and dt (or tol for the time steps) instead."
-        )
-    if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
-        raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
-    if on_run is not None and not callable(on_run):
-        raise SceneError(f"on_run must be a function of a finished run (a Result), got {on_run!r}.")
+    method = _check_request(scene, method, tol, on_run, options)
     ladder = LADDERS[method]
     max_elements = cell_budget(scene, max_elements)
     max_wall = check_max_wall(max_wall)
     deadline = None if max_wall is None else time.perf_counter() + max_wall
     cells = ladder.cells_of(scene, t_end)
-    for key in ("dt_max", "dt", *ladder.keys):
-        if key in options:
-            raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
     if folder is not None:
         folder.say(f"femehl: automatic run to tol = {tol:g} (pilot runs in memory, then the run itself)")
 
@@ -703,23 +687,9 @@ def solve_to_tolerance(
     family = 0  # runs[family:] are on the current ladder (a pair is made within it only)
     adapted_at = None  # the level of the run the meshes were adapted to
     while True:
-        ne = cells(level)
-        over_cells = ne > max_elements
-        if (runs or failed) and (over_cells or not in_time(level)):
-            fit = cell_fit = None
-            if runs and not last:
-                fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
-                cell_fit = (
-                    fit
-                    if deadline is None
-                    else budget_level(cells, runs[-1].info["level"], level, max_elements)
-                )
-            # the budget that binds: time, when the cells alone are not exceeded or allow a
-            # finer level than the time does (beyond the bisection's 1 %)
-            time_binds = not over_cells or (cell_fit is not None and (fit is None or cell_fit < fit / 1.02))
-            why = "time budget" if time_binds else "cell budget"
+        if (runs or failed) and (cells(level) > max_elements or not in_time(level)):
+            fit, why = _within_budget(cells, runs, level, max_elements, in_time, deadline, last)
             if fit is None:
-                logger.info("auto: level %.3g (~%.0f cells) is over the %s: stop", level, ne, why)
                 stopped = why
                 if failed is not None and not runs:
                     if why == "time budget":
@@ -730,13 +700,6 @@ def solve_to_tolerance(
                         ) from failed
                     raise failed  # no level within the budget got through
                 break
-            logger.info(
-                "auto: level %.3g (~%.0f cells) is over the %s: a run at level %.3g, the finest within it",
-                level,
-                ne,
-                why,
-                fit,
-            )
             # the cell budget's fit is the finest level there is; the time budget's is
             # asked again after the run (a run cheaper than predicted leaves time for more)
             level, last, stopped = fit, why == "cell budget", why
@@ -763,7 +726,7 @@ def solve_to_tolerance(
             if not runs:
                 raise TimeBudgetError(
                     f"no run finished within max_wall = {max_wall:g} s: the first, at level {level:.3g} "
-                    f"(~{ne:.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. Give a larger "
+                    f"(~{cells(level):.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. Give a larger "
                     "max_wall, or a coarser first level (level=).",
                     t=exc.t,
                 ) from None
@@ -807,6 +770,55 @@ def solve_to_tolerance(
                 continue
         level = _next_level(level, err, tol) if len(runs) - family >= 2 else level / 2.0
     return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall, adapted_at)
+
+
+def _check_request(scene, method, tol, on_run, options) -> str:
+    """The method of an automatic run (SceneError naming the fix for a bad request)."""
+    from femehl.solver.loop import _registry
+
+    method = scene.default_method if method is None else method
+    if method not in LADDERS:
+        known = sorted(_registry())
+        raise SceneError(
+            f"method {method!r} has no refinement ladder, so it cannot choose its own "
+            f"discretization; automatic methods: {sorted(LADDERS)} (all: {known}). "
+            "Give its discretization options and dt (or tol for the time steps) instead."
+        )
+    if isinstance(tol, bool) or not (isinstance(tol, float | int) and 0 < tol < 1):
+        raise SceneError(f"tol must be a number in (0, 1), e.g. 1e-2 for 1 %; got {tol!r}.")
+    if on_run is not None and not callable(on_run):
+        raise SceneError(f"on_run must be a function of a finished run (a Result), got {on_run!r}.")
+    for key in ("dt_max", "dt", *LADDERS[method].keys):
+        if key in options:
+            raise SceneError(f"solve_to_tolerance chooses {key!r} itself; do not pass it.")
+    return method
+
+
+def _within_budget(cells, runs, level, max_elements, in_time, deadline, last) -> tuple:
+    """``(fit, why)`` when ``level`` is over a budget: the finest level within it to run
+    instead (None: stop), and which budget binds (``"cell budget"`` or ``"time budget"``)."""
+    ne = cells(level)
+    over_cells = ne > max_elements
+    fit = cell_fit = None
+    if runs and not last:
+        fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
+        last_level = runs[-1].info["level"]
+        cell_fit = fit if deadline is None else budget_level(cells, last_level, level, max_elements)
+    # the budget that binds: time, when the cells alone are not exceeded or allow a
+    # finer level than the time does (beyond the bisection's 1 %)
+    time_binds = not over_cells or (cell_fit is not None and (fit is None or cell_fit < fit / 1.02))
+    why = "time budget" if time_binds else "cell budget"
+    if fit is None:
+        logger.info("auto: level %.3g (~%.0f cells) is over the %s: stop", level, ne, why)
+    else:
+        logger.info(
+            "auto: level %.3g (~%.0f cells) is over the %s: a run at level %.3g, the finest within it",
+            level,
+            ne,
+            why,
+            fit,
+        )
+    return fit, why
 
 
 def _adapted(ladder: Ladder, res: Result, scene, t_end: float) -> Ladder | None:

@@ -5,6 +5,7 @@ than uniform ones."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -89,3 +90,22 @@ def test_bad_input_is_refused(source):
         adapted_sizes(fake_run(source), 3)
     with pytest.raises(SceneError, match="level"):
         adapted_sizes(fake_run(source), 1000).cells(0.0)
+
+
+def test_a_full_disk_run_and_the_plan_round_trip():
+    """Sizes from a real FE run on the full disk (an indenter not symmetric in y), and the
+    adapted ladder a resumed run rebuilds from a run folder's plan meshes the same disk."""
+    import femehl
+    from femehl.accuracy.auto import _ladder_of, adapted_ladder
+    from femehl.problem.indenters import Shape
+
+    tilted = Shape(lambda x, y: (x**2 + y**2) / 2 + 0.05 * y)
+    scene = dataclasses.replace(femehl.presets.paper_sphere(), indenter=tilted)
+    res = femehl.solve(scene, t_end=0.3, dt=0.05, mesh="coarse", store_every=1, estimate=False)
+    assert res.disc.half is False
+    sizes = adapted_sizes(res, 800)
+    ladder = adapted_ladder(sizes)
+    mesh = ladder.options(scene, 0.3, 1.0)["mesh"]
+    assert mesh.half is False and mesh.mesh.t.shape[1] == pytest.approx(800, rel=0.3)
+    again = _ladder_of("fe", {"level": 1.0, **ladder.record})
+    assert np.array_equal(again.options(scene, 0.3, 1.0)["mesh"].mesh.p, mesh.mesh.p)

@@ -101,12 +101,15 @@ def worker(spec: dict) -> dict:
     return out
 
 
-def run_in_subprocess(spec: dict, cap: float | None = None) -> dict:
+def run_in_subprocess(spec: dict, cap: float | None = None, script: str | None = None) -> dict:
+    """``spec`` run by ``script --worker`` (this file by default) in its own process with one
+    BLAS thread; the record it prints, with the load average and provenance, or a status."""
     env = dict(os.environ)
     for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         env[v] = "1"
     env.setdefault("MPLBACKEND", "Agg")
-    cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "--worker", json.dumps(spec)]
+    script = str(pathlib.Path(__file__ if script is None else script).resolve())
+    cmd = [sys.executable, script, "--worker", json.dumps(spec)]
     t = time.perf_counter()
     try:
         p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=cap)

@@ -49,12 +49,11 @@ import json
 import math
 import os
 import pathlib
-import subprocess
 import sys
 import time
 from types import SimpleNamespace
 
-from _machine import machine, provenance
+from _machine import machine
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROWS = HERE / "one_run_estimate.jsonl"
@@ -174,23 +173,12 @@ def worker(spec: dict) -> dict:
 
 
 def run_in_subprocess(spec: dict, cap: float) -> dict:
-    env = dict(os.environ)
-    for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        env[v] = "1"
-    env.setdefault("MPLBACKEND", "Agg")
-    cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "--worker", json.dumps(spec)]
+    """``spec`` in its own process (``femehl bench auto``'s runner), its wall time the process's."""
+    from auto import run_in_subprocess as run
+
     t = time.perf_counter()
-    try:
-        p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=cap)
-    except subprocess.TimeoutExpired:
-        return dict(spec, status=f"capped at {cap:g} s", wall_s=time.perf_counter() - t)
-    if p.returncode != 0:
-        tail = p.stderr.strip().splitlines()[-1:] or ["?"]
-        return dict(spec, status=f"crashed: {tail[0]}", wall_s=time.perf_counter() - t)
-    rec = json.loads(p.stdout.strip().splitlines()[-1])
+    rec = run(spec, cap, script=__file__)
     rec["wall_s"] = time.perf_counter() - t
-    rec["loadavg"] = os.getloadavg()
-    rec.update(provenance())
     return rec
 
 

@@ -25,6 +25,8 @@ GRADE = 0.25
 #: point (a punch's edge) does not take the cells a finite feature needs (sizes go at most
 #: sqrt(CAP) = 4 times below the percentile's)
 CAP = 16.0
+#: a state's pressure curvature is relative to its peak, at least this fraction of the run's
+PEAK_FLOOR = 0.01
 #: no size above this fraction of the domain radius
 H_MAX = 0.25
 #: calibration passes of the size field's scale to the wanted cell count
@@ -67,11 +69,11 @@ def _hessian_norm(p, t, areas, vn) -> np.ndarray:
     return np.abs(half_trace) + root
 
 
-def curvature_indicator(disc, state) -> np.ndarray:
-    """Per cell of an FE disk ``disc``: ``max(|H d| / d, |H p| / max|p|)`` at ``state``, the
-    recovered Hessians of the film (relative to the local film: a thin film's relative error
-    is the one the minimum film shows) and of the pressure (relative to its peak: the
-    load's)."""
+def curvature_indicator(disc, state, floor: float = 0.0) -> np.ndarray:
+    """Per cell of an FE disk ``disc``: ``max(|H d| / d, |H p| / max(max|p|, floor))`` at
+    ``state``, the recovered Hessians of the film (relative to the local film: a thin film's
+    relative error is the one the minimum film shows) and of the pressure (relative to its
+    peak, the load's error; at least ``floor``)."""
     mesh = disc.mesh
     p, t, areas = mesh.p, mesh.t, disc.areas
     n = p.shape[1]
@@ -83,7 +85,7 @@ def curvature_indicator(disc, state) -> np.ndarray:
         pn = pv
     else:
         pn[disc.free] = pv
-    peak = float(np.max(np.abs(pn)))
+    peak = max(float(np.max(np.abs(pn))), float(floor))
     if not peak > 0.0:
         return film
     return np.maximum(film, _hessian_norm(p, t, areas, pn) / peak)
@@ -199,9 +201,12 @@ def adapted_sizes(result, cells: float, *, grade: float = GRADE) -> AdaptedSizes
         raise SceneError(f"cells must be a number >= 10, got {cells!r}.")
     mesh = disc.mesh
     p, t, areas = mesh.p, mesh.t, disc.areas
+    # a state's pressure relative to its own peak, but at least PEAK_FLOOR of the run's: the
+    # weak pressure of the first steps (the initial layer, t ~ 1e-6) does not shape the mesh
+    floor = PEAK_FLOOR * max(float(np.max(np.abs(np.asarray(s.p, dtype=float)))) for s in states)
     m = np.zeros(t.shape[1])
     for state in states:
-        m = np.maximum(m, curvature_indicator(disc, state))
+        m = np.maximum(m, curvature_indicator(disc, state, floor))
     if not np.all(np.isfinite(m)) or not np.any(m > 0.0):
         raise MeshError("the run's film and pressure give no finite curvature to adapt a mesh to.")
     order = np.argsort(m)

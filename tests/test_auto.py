@@ -177,6 +177,29 @@ def test_expert_adaptive_space_estimate_is_honest(line_reference):
     check_space_part(res, ref)
 
 
+def test_meshes_are_adapted_at_most_once(monkeypatch):
+    """The pilots' pair at 0.5 tol declines the adapted meshes, and that is final: the next
+    run (level 1.41, also <= ADAPT_LEVEL) estimated at 0.9 tol does not adapt; the fitted
+    sequence goes on to its answer."""
+    import femehl.accuracy.auto as auto
+
+    real, tol = auto.estimate, 1e-2
+    worst = iter([0.5 * tol, 0.9 * tol, 0.7 * tol])
+
+    def scaled(fine, coarse, ratio):
+        est = real(fine, coarse, ratio)
+        k = next(worst) / est.worst()
+        errors = {q: {p: v * k for p, v in est[q].items()} for q in QUANTITIES}
+        return dataclasses.replace(est, errors=errors)
+
+    monkeypatch.setattr(auto, "estimate", scaled)
+    res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.05, tol=tol, store_every=0)
+    a = res.info["auto"]
+    assert a["reached"] and a["adapted_at"] is None
+    assert a["levels"][:3] == [4.0, 2.0, pytest.approx(2.0 / np.sqrt(2.0))] and len(a["levels"]) == 4
+    assert not res.disc.dm.name.startswith("adapted")
+
+
 def test_sphere_is_honest():
     """The paper sphere to t = 1.5 at tol = 3e-2: fitted levels 4 and 2 (192 / 788 cells),
     then meshes adapted to the level-2 run, levels 2 and 1 (796 / 3,020 cells), 236 steps

@@ -685,7 +685,7 @@ def solve_to_tolerance(
     runs, est, reached, err = [], None, False, math.nan
     fine, failed, last, stopped = None, None, False, None
     family = 0  # runs[family:] are on the current ladder (a pair is made within it only)
-    adapted_at = None  # the level of the run the meshes were adapted to
+    seeded, adapted_at = False, None  # one run may seed adapted meshes; the level of that run
     while True:
         if (runs or failed) and (cells(level) > max_elements or not in_time(level)):
             fit, why = _within_budget(cells, runs, level, max_elements, in_time, deadline, last)
@@ -705,7 +705,7 @@ def solve_to_tolerance(
             level, last, stopped = fit, why == "cell budget", why
         candidate = len(runs) >= MIN_RUNS - 1 and len(runs) > family
         previous = runs[-1] if candidate else None
-        seed = ladder.adapt is not None and family == 0 and level <= ADAPT_LEVEL
+        seed = ladder.adapt is not None and not seeded and level <= ADAPT_LEVEL
         try:
             res = _run(
                 scene,
@@ -762,6 +762,7 @@ def solve_to_tolerance(
             break
         if last:
             break
+        seeded = seeded or seed  # adapted to it or not, the meshes are decided once
         if seed and not err <= ACCEPT * tol:  # from here on, meshes adapted to this run, from its level again
             adapted = _adapted(ladder, res, scene, t_end)
             if adapted is not None:
@@ -769,6 +770,7 @@ def solve_to_tolerance(
                 cells = ladder.cells_of(scene, t_end)
                 continue
         level = _next_level(level, err, tol) if len(runs) - family >= 2 else level / 2.0
+    adapted_at = adapted_at if len(runs) > family else None  # no run was made on adapted meshes
     return _finish(fine, est, runs, tol, reached, None if reached else stopped, max_wall, adapted_at)
 
 
@@ -801,9 +803,9 @@ def _within_budget(cells, runs, level, max_elements, in_time, deadline, last) ->
     over_cells = ne > max_elements
     fit = cell_fit = None
     if runs and not last:
-        fit = budget_level(cells, runs[-1].info["level"], level, max_elements, fits=in_time)
-        last_level = runs[-1].info["level"]
-        cell_fit = fit if deadline is None else budget_level(cells, last_level, level, max_elements)
+        before = runs[-1].info["level"]
+        fit = budget_level(cells, before, level, max_elements, fits=in_time)
+        cell_fit = fit if deadline is None else budget_level(cells, before, level, max_elements)
     # the budget that binds: time, when the cells alone are not exceeded or allow a
     # finer level than the time does (beyond the bisection's 1 %)
     time_binds = not over_cells or (cell_fit is not None and (fit is None or cell_fit < fit / 1.02))

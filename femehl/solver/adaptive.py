@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from femehl.errors import FilmRuptureError, SceneError, SolverError
-from femehl.solver.stepping import State, _restart, breakpoints_of, film_floor, film_positive
+from femehl.solver.stepping import State, breakpoints_of, film_floor, film_positive, without_history
 from femehl.validation import check_positive
 
 __all__ = ["AdaptiveSteps", "StepController", "breakpoints_of", "CONTROLS"]
@@ -342,7 +342,7 @@ class AdaptiveSteps:
         self._dt0, self._dt_min, self._dt_max, self._eps, self._t_end = dt0, dt_min, dt_max, eps, t_end
         self._run = _Run(
             dt=dt0,
-            levels=[_restart(state)],
+            levels=[without_history(state)],
             load_scale=abs(_load(state)),
             film0=film_floor(state)[0],
             instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
@@ -447,7 +447,7 @@ class AdaptiveSteps:
         if run.pending is not None:
             yield from _emit(run, run.pending, run.pending_rejected, math.nan)
         if run.stops:
-            run.levels = [_restart(run.levels[-1])]
+            run.levels = [without_history(run.levels[-1])]
             run.origin = run.levels[0].t
             run.dt = min(run.dt, self._dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)

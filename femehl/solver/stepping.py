@@ -27,6 +27,7 @@ __all__ = [
     "FixedSteps",
     "GivenSteps",
     "breakpoints_of",
+    "without_history",
     "check_run",
     "Scheme",
     "SCHEMES",
@@ -127,7 +128,19 @@ def get_scheme(name: str) -> Scheme:
     return SCHEMES[name]
 
 
-class FixedSteps:
+class _Planned:
+    """A step policy whose steps are known in advance: a step that fails raises (nothing is
+    retried), an accepted one is yielded and ``_accepted`` moves the plan on."""
+
+    def judge(self, trial: State | None, failure: Exception | None):
+        if failure is not None:
+            raise failure
+        _check_film(trial)
+        self._accepted(trial)
+        yield trial
+
+
+class FixedSteps(_Planned):
     """The step policy of fixed steps ``dt``: steps land on ``k dt``, the last is shortened to
     land on ``t_end``; a step that fails raises (nothing is retried)."""
 
@@ -159,16 +172,12 @@ class FixedSteps:
             return None
         return self._last, t_new, h
 
-    def judge(self, trial: State | None, failure: Exception | None):
-        if failure is not None:
-            raise failure
-        _check_film(trial)
+    def _accepted(self, trial: State) -> None:
         self._k += 1
         self._last = trial
-        yield trial
 
 
-class GivenSteps:
+class GivenSteps(_Planned):
     """The step policy that lands on given ``times`` (e.g. another run's, so that two
     discretizations are compared at the same steps), then on ``t_end``.  As adaptive steps
     do, the history is dropped at the motion's breakpoints and at ``start`` (a backward-Euler
@@ -184,7 +193,7 @@ class GivenSteps:
         from femehl.validation import check_positive
 
         t_end = check_positive("t_end", t_end, "Give the end time of the run in normalized units.")
-        state = stepper.initial_state() if start is None else _restart(start)
+        state = stepper.initial_state() if start is None else without_history(start)
         if t_end <= state.t:
             raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
         eps = 1e-12 * max(1.0, abs(t_end))
@@ -199,16 +208,12 @@ class GivenSteps:
             return None
         base, t_new = self._last, self._stops[0]
         if any(abs(base.t - b) <= self._eps for b in self._breaks):
-            base = _restart(base)
+            base = without_history(base)
         return base, t_new, t_new - base.t
 
-    def judge(self, trial: State | None, failure: Exception | None):
-        if failure is not None:
-            raise failure
-        _check_film(trial)
+    def _accepted(self, trial: State) -> None:
         self._stops.pop(0)
         self._last = trial
-        yield trial
 
 
 def breakpoints_of(scene) -> tuple:
@@ -217,7 +222,7 @@ def breakpoints_of(scene) -> tuple:
     return tuple(getattr(motion, "breakpoints", ()) or ())
 
 
-def _restart(state: State) -> State:
+def without_history(state: State) -> State:
     """``state`` without its history: the next step is a backward-Euler (start) step."""
     return dataclasses.replace(state, d_prev=None, dt_prev=None)
 

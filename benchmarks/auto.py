@@ -383,6 +383,22 @@ def targets(records: list, refs: dict) -> list:
     return out
 
 
+class Series:
+    """A recorded run's headline series (``t`` and the quantities): ``value_at`` as a Result's."""
+
+    def __init__(self, record: dict):
+        import numpy as np
+
+        self.t = np.asarray(record["t"], dtype=float)
+        self._q = {q: np.asarray(record[q], dtype=float) for q in ("load", "film_center", "film_min")}
+        self.info = {"level": float(record["level"])}
+
+    def value_at(self, name: str, t: float) -> float:
+        import numpy as np
+
+        return float(np.interp(t, self.t, self._q[name]))
+
+
 def pair_estimate(a: dict, b: dict, t_from: float) -> float:
     """The automatic mode's estimate of the finer fixed-step run ``b`` from the coarser ``a``
     (records with ``level``, ``t`` and the series): ``femehl.accuracy.auto.pair_error``, worst over the
@@ -391,10 +407,10 @@ def pair_estimate(a: dict, b: dict, t_from: float) -> float:
 
     import numpy as np
 
-    from femehl.accuracy.auto import CompanionSeries, pair_error
+    from femehl.accuracy.auto import pair_error
 
     fine = SimpleNamespace(t=np.asarray(b["t"]), **{q: np.asarray(b[q]) for q in QUANTITIES})
-    coarse, ratio = CompanionSeries(a), a["level"] / b["level"]
+    coarse, ratio = Series(a), a["level"] / b["level"]
     keep = fine.t >= t_from - 1e-9
     return max(float(np.max(pair_error(fine, coarse, q, ratio)[keep])) for q in QUANTITIES)
 

@@ -56,6 +56,9 @@ from types import SimpleNamespace
 from _machine import machine
 
 HERE = pathlib.Path(__file__).resolve().parent
+#: the automatic mode's time tolerance at level 1 when this study was made (femehl.auto's
+#: TAU1 until 2026-12-05; now 5 times it): kept so that the study reruns as it was made
+STUDY_TAU1 = 1.25e-3
 ROWS = HERE / "one_run_estimate.jsonl"
 TABLE = HERE / "one_run_estimate.md"
 REFERENCE = HERE / "auto_reference_scenes.json"
@@ -126,7 +129,7 @@ def worker(spec: dict) -> dict:
     """The fine run and its five replays (in this process, one after the other)."""
     import numpy as np
 
-    from femehl.accuracy.auto import LADDERS, time_error, time_tolerance
+    from femehl.accuracy.auto import LADDERS, time_error
     from femehl.errors import FemehlError
     from femehl.solver.loop import run_scene
     from femehl.solver.stepping import GivenSteps
@@ -136,7 +139,7 @@ def worker(spec: dict) -> dict:
     level, mult = float(spec["level"]), float(spec["mult"])
     ladder = LADDERS["fe"]
     breaks = tuple(float(b) for b in scene.motion.breakpoints)
-    step_tol = time_tolerance(level) * mult
+    step_tol = STUDY_TAU1 * level**2 * mult
     out = dict(spec, status="ok", t_end=t_end, step_tol=step_tol, breakpoints=breaks, runs={})
 
     def one(name, lv, every=1, **steps):
@@ -196,9 +199,9 @@ def _series(run):
 
 
 def _companion(run):
-    from femehl.accuracy.auto import CompanionSeries
+    from auto import Series
 
-    return CompanionSeries({"level": run["level"], **{k: run[k] for k in ("t", *QUANTITIES)}})
+    return Series({"level": run["level"], **{k: run[k] for k in ("t", *QUANTITIES)}})
 
 
 def space_estimate(row, name, q, ratio):

@@ -95,7 +95,7 @@ def solve(
       minimum film are within ``tol`` (default 1e-2) at every step
       (:func:`femehl.accuracy.auto.solve_to_tolerance`); the result carries the error estimate,
       ``result.uncertainty(name, t)``; ``max_wall=`` (seconds) and ``max_elements=``
-      (cells) bound what it may spend, ``on_run=`` sees every finished run (pilots too);
+      (cells) bound what it may spend, ``on_run=`` sees every finished run (the first too);
     * **expert** (``dt`` or ``mesh=`` / ``dr=`` / ``n_elements=`` ... given): that
       discretization, with fixed steps ``dt`` (default 0.01), or adaptive steps when
       ``step_tol`` is given.  The result carries the space part of the error estimate
@@ -274,8 +274,8 @@ def _expert(
     )
     if not estimate or folder is not None and folder.resume or result.info.get("nothing_to_do"):
         return result  # a resumed run: no companion for its part only
-    companion, ratio = companion_run(scene, result.method, options, result, dt, step_tol)
-    result.estimate = expert_estimate(result, companion, ratio, adaptive=step_tol is not None)
+    full, half, ratio, order = companion_run(scene, result.method, options, result, dt, step_tol)
+    result.estimate = expert_estimate(result, full, half, ratio, order, adaptive=step_tol is not None)
     return result
 
 

@@ -417,14 +417,15 @@ def _print_choice(res) -> None:
     a = res.info.get("auto")
     if not a or "levels" not in a:
         return
+    spent = a.get("estimate_wall") or [None] * len(a["wall"])
     runs = ", ".join(
-        f"{n} cells / {k} steps / {w:.1f} s"
-        for n, k, w in zip(a["elements"], a["steps"], a["wall"], strict=True)
+        f"{n} cells / {k} steps / {w:.1f} s" + ("" if e is None else f" (+{e:.1f} s its estimate)")
+        for n, k, w, e in zip(a["elements"], a["steps"], a["wall"], spent, strict=True)
     )
     status = "reached" if a["reached"] else f"NOT reached ({a.get('stopped') or 'budget'})"
     total = a.get("total", float("nan"))
     err = (
-        "no estimate: one run only"
+        "no estimate: its companion runs stopped"
         if not math.isfinite(total)
         else f"estimated error up to {100 * total:.2g} %"
     )

@@ -81,6 +81,23 @@ def test_sphere_extent_under_load():
     assert contact_extent(sc, 3.0) == pytest.approx((1.0, 1.0), rel=1e-6)
 
 
+def test_a_free_indenter_is_fitted_to_its_free_fall():
+    """A free indenter (mass, force): its fitted extent is the deepest dry indentation the
+    force can drive it to from its initial gap, the Hertz energy balance in closed form
+    ``(4 / (3 pi)) (2/5) delta^(5/2) = F (delta + h0)`` (the film only slows it: the run's
+    deepest point, hc = -1.72 with this film, is above it), deeper than the static load's."""
+    from femehl.elastic.contact import dry_contact_extent
+
+    F_ = 4.0 / (3.0 * math.pi)  # the Hertz load at delta = 1
+    sc = Scene(indenter=Sphere(1.0), motion=Motion(gap=0.1, velocity=0.0, mass=0.1, force=F_))
+    ax, ay, delta = dry_contact_extent(sc, 2.0)
+    assert F_ * 0.4 * delta**2.5 == pytest.approx(F_ * (delta + 0.1), rel=1e-3)
+    assert 1.72 < delta and ax == ay == pytest.approx(math.sqrt(delta), rel=1e-9)
+    # nothing pushes it down: no contact to fit
+    still = Scene(indenter=Sphere(1.0), motion=Motion(gap=0.1, velocity=0.0, mass=0.1))
+    assert dry_contact_extent(still, 2.0) == (0.0, 0.0, 0.0)
+
+
 def test_generic_shape_uses_sneddon():
     """A Shape that is a sphere goes through the ray-by-ray Sneddon route: a = 1 to 1e-4."""
     sc = Scene(

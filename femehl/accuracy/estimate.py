@@ -1,7 +1,7 @@
 """The one error-estimate type: :class:`Estimate` (docs/design.md sections 8 and 9).
 
-Made in :mod:`femehl.accuracy.auto` only (:func:`~femehl.accuracy.auto.estimate`,
-:func:`~femehl.accuracy.auto.expert_estimate`); read by
+Made in :mod:`femehl.accuracy.auto` only (:func:`~femehl.accuracy.auto.one_run_estimate`,
+:func:`~femehl.accuracy.auto.expert_estimate`, :func:`~femehl.accuracy.auto.estimate`); read by
 :meth:`femehl.output.result.Result.uncertainty` and written by
 :func:`femehl.output.table.add_error_columns`.
 """
@@ -19,9 +19,9 @@ __all__ = ["Estimate", "PARTS", "HOWS"]
 
 #: the parts of each quantity's estimate
 PARTS = ("total", "space", "time")
-#: how an estimate was made: a Richardson pair of the automatic sequence, an expert run's
-#: coarser companion, its step controller only, or a resumed run's going on from its earlier part
-HOWS = ("pair", "companion", "controller", "resumed")
+#: how an estimate was made: a run's coarser companions (its space and time parts), its
+#: step controller only (time), or a Richardson pair of two runs (the check)
+HOWS = ("companion", "controller", "pair")
 
 
 @dataclass(frozen=True)
@@ -73,17 +73,3 @@ class Estimate:
         name = max(self.errors, key=lambda q: float(np.max(self.errors[q]["total"])))
         k = int(np.argmax(self.errors[name]["total"]))
         return f"{name} at t = {float(self.t[k]):.4g}"
-
-    def continued(self, last: Mapping[str, float]) -> Estimate:
-        """A resumed run's estimate going on from its earlier part's ``last`` values
-        (``{(name, part): value}`` at the earlier part's end): the total is a running
-        maximum over the whole run and the time part accumulates."""
-        errors = dict(self.errors)
-        for q, parts in self.errors.items():
-            total0, time0 = last.get((q, "total"), np.nan), last.get((q, "time"), np.nan)
-            if parts["total"] is None or not np.isfinite(total0):
-                continue
-            total = np.maximum(parts["total"], total0)
-            tpart = np.minimum(parts["time"] + (time0 if np.isfinite(time0) else 0.0), total)
-            errors[q] = {"total": total, "space": total - tpart, "time": tpart}
-        return Estimate(self.t, errors, "resumed", self.ratio, self.levels)

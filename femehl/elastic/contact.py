@@ -315,9 +315,44 @@ def indentation(scene, *, load: float | None = None, depth: float | None = None,
 def dry_contact_extent(scene, t_end: float) -> tuple[float, float, float]:
     """``(ax, ay, delta)``: the largest dry-contact semi-axes of a run to ``t_end`` and its
     deepest indentation (:func:`indentation` at the largest load ``F(t)``, or at
-    ``-min hc(t)``; ``t`` on 2001 points of ``[0, t_end]`` plus the history's knots)."""
+    ``-min hc(t)``, or a free indenter's :func:`free_fall_depth`; ``t`` on 2001 points of
+    ``[0, t_end]`` plus the history's knots)."""
     motion = scene.motion
+    if motion.free:
+        F = max(float(motion.applied_force(float(t))) for t in _run_times(motion.force, t_end))
+        return indentation(scene, depth=free_fall_depth(scene, F))
     if motion.load_controlled:
         F = max(float(motion.F(float(t))) for t in _run_times(motion.load, t_end))
         return indentation(scene, load=F)
     return indentation(scene, depth=-min(float(motion.hc(float(t))) for t in _run_times(motion.gap, t_end)))
+
+
+def free_fall_depth(scene, force: float) -> float:
+    """The deepest dry indentation a free indenter can reach under a constant ``force``:
+    the depth where the dry contact's stored energy ``int_0^delta load`` equals the work of
+    ``force`` from the initial gap ``hc(0)`` plus the initial kinetic energy ``m hc'(0)^2 / 2``
+    (no film, no damping: an upper bound; the film only slows it).  0 when it does not
+    touch (a rigid substrate, or nothing pushes it down)."""
+    motion = scene.motion
+    gap0 = max(0.0, float(motion.hc(0.0)))
+    kinetic = 0.5 * float(motion.mass) * float(motion.hc_dot0) ** 2
+    if force <= 0.0 and kinetic == 0.0:
+        return 0.0
+    dry = _dry_contact(scene.substrate, sample_shape(scene))
+    if dry.load is None:
+        return 0.0
+
+    def surplus(delta: float) -> float:
+        s = np.linspace(0.0, delta, 65)
+        stored = float(np.trapezoid([0.0] + [dry.load(float(x)) for x in s[1:]], s))  # no load at 0
+        return stored - max(force, 0.0) * (delta + gap0) - kinetic
+
+    lo, hi = 0.0, 1e-3
+    while surplus(hi) < 0.0:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1e6:
+            raise SceneError(f"contact_extent: {dry.what} cannot stop the free indenter; check its force")
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if surplus(mid) < 0.0 else (lo, mid)
+    return hi

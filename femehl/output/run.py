@@ -154,23 +154,26 @@ class RunFolder:
         }
 
     def finish(self, res: Result) -> Result:
-        """The answer in the folder (a pilot, when the budget ended the sequence in the
-        pilots), its error columns, ``auto.json`` and the report."""
+        """The answer in the folder (the first run, held in memory, when the budget ended the
+        sequence after it), its error columns, ``auto.json`` and the report."""
         if res.info.get("nothing_to_do"):
             return res
         if not self.written:
-            self._write_pilot(res)
+            self._write_first(res)
         _write_estimate(self.path, res)
-        res.info["wall_s"] = time.perf_counter() - self.t0  # companion, pilots and candidates too
+        res.info["wall_s"] = time.perf_counter() - self.t0  # companions, first run and candidates too
         if res.estimate is not None and res.estimate.how == "companion":
-            self.say(f"femehl: space estimate from a companion run {res.estimate.ratio:.3g} times coarser")
+            self.say(
+                f"femehl: error estimate from companion runs {res.estimate.ratio:.3g} times coarser on the "
+                "run's steps (space) and on steps twice as long (time)"
+            )
         self.say_choice(res.info.get("auto", {}))
         return res
 
-    def _write_pilot(self, res: Result) -> None:
+    def _write_first(self, res: Result) -> None:
         self.say(
             f"femehl: the budget ended the sequence before a run that could be the answer; "
-            f"writing the last pilot (level {res.info['level']:.3g}) into {self.path}"
+            f"writing the first run (level {res.info['level']:.3g}) into {self.path}"
         )
         try:
             res.save(self.path, overwrite=self.overwrite)

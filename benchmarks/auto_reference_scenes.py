@@ -5,7 +5,8 @@ and ``film_min`` (and where the minimum film is) to ``t_end``:
 
 * FE, BDF2 at the FIXED step ``DT = 0.005`` (``DT / 2`` for the scenes of
   :data:`DT_OVERRIDES`, the time error there as large as the errors checked), on the fitted meshes
-  ``femehl.discretize.fitted.fitted_disk(scene, t_end, level)`` at two levels ``L_a = 0.7`` and
+  ``femehl.discretize.fitted.fitted_disk(scene, t_end, level)`` (fitted to
+  ``auto_scenes.MESH_SCENES[name]()`` instead of the scene where it has one) at two levels ``L_a = 0.7`` and
   ``L_b = 0.5`` (size ratio ``r = L_a / L_b = 1.4``, about twice the elements);
 * the reference is the Richardson extrapolation in h of order 2 at every time of the
   series (both runs have the same fixed times):
@@ -163,6 +164,39 @@ LEVEL_OVERRIDES = {
         "tol = 1e-2 ended on the finer reference mesh (level 0.5); levels 0.35 and 0.25 (about "
         "23,000 and 46,000 elements, the fast operator) and three levels for the observed order",
     ),
+    **{
+        name: (
+            (0.5, 0.5 / 1.4),
+            "the plug-in scenes on the half space (fast operator from 12,000 elements on): the paper's "
+            "sphere and motion, whose film_min correction at levels (0.7, 0.5) was 0.54 % (paper, "
+            "t = 5), half the tolerance it checks; levels 0.5 and 0.357 (about 12,000 and 23,000 "
+            "elements; free_indenter about 1.4 times more) and level 0.7 the third, coarser one "
+            "(2026-12-05)",
+        )
+        for name in ("barus", "free_indenter")
+    },
+    "viscoelastic": (
+        (0.5 / 1.4, 0.5 / 1.96),
+        "at levels (0.5, 0.357) the film_min correction was 1.07 % at t = 1.96 (the exit "
+        "constriction of the sliding start; observed order 1.7 there against level 0.7, so "
+        "asymptotic but with a large constant) and the film_center one 0.49 %; levels 0.357 and "
+        "0.255 (about 21,000 and 41,000 elements, the fast operator), level 0.5 the third, "
+        "coarser one (2026-12-05)",
+    ),
+    "jfo": (
+        (0.7, 0.5),
+        "JFO to t = 3: the cavitated set's switching makes each step 2-3 times dearer than the "
+        "isoviscous run's (benchmarks/cavitation.md); levels 0.7 and 0.5 (about 6,000 and 12,000 "
+        "elements over 600 steps) and a third, coarser level 0.98 for the observed order "
+        "(2026-12-05)",
+    ),
+    "layer": (
+        (0.5, 0.5 / 1.4),
+        "Layer(1) has a dense operator only (no fast one); at levels (0.7, 0.5) the film_min "
+        "correction was 1.47 % at t = 1.63 (the exit constriction; three levels 0.98, 0.7, 0.5 not "
+        "monotone there); levels 0.5 and 0.357 (about 10,600 and 20,600 elements, dense), level "
+        "0.7 the third, coarser one (2026-12-05)",
+    ),
     "steady_b1000": (
         (0.5, 0.35),
         "at levels (1, 0.7) the films' correction was 1.0-1.5 %; levels 0.5 and 0.35 (about "
@@ -260,6 +294,7 @@ def child(name: str, level: float, dt: float, t_end: float | None) -> dict:
     (the cost probe runs a few steps on the same mesh as the real runs).
     """
     import numpy as np
+    from auto_scenes import mesh_scene
 
     import femehl
     from femehl.discretize.fitted import fitted_disk
@@ -267,7 +302,7 @@ def child(name: str, level: float, dt: float, t_end: float | None) -> dict:
     scene, t_scene = _scene(name)
     t_run = t_scene if t_end is None else t_end
     t0 = time.perf_counter()
-    dm = fitted_disk(scene, t_scene, level=level)
+    dm = fitted_disk(mesh_scene(name), t_scene, level=level)
     t_mesh = time.perf_counter() - t0
     stamps = []
 
@@ -333,11 +368,13 @@ def estimate(name: str) -> dict:
     N^2; measured N^1.8-2.1 on the ladder).  With the levels (1.0, 0.7) the probe is the
     time-error run itself.
     """
+    from auto_scenes import mesh_scene
+
     from femehl.discretize.fitted import fitted_sizes
 
     scene, t_end = _scene(name)
     half = bool(getattr(scene.indenter, "symmetric_y", False))
-    ne = {lev: fitted_sizes(scene, t_end, lev).estimate_elements(half) for lev in (1.0, 0.7, 0.5)}
+    ne = {lev: fitted_sizes(mesh_scene(name), t_end, lev).estimate_elements(half) for lev in (1.0, 0.7, 0.5)}
     probe = run_child(name, 1.0, 2 * DT)
     out = {"elements_est": {f"{k:g}": round(v) for k, v in ne.items()}, "probe": probe, "cost_s": {}}
     if "error" in probe:
@@ -761,6 +798,20 @@ Notes
   order 2.1 / 2.0 / 4.0 at t = 2 (load / film_center / film_min; JSON `diagnostics`).
   The first winkler choice k = 1 converged at order 0.46 in film_min (5 % between levels
   0.5 and 0.357): replaced by k = 0.25.
+* The plug-in scenes (2026-12-05; `LEVEL_OVERRIDES`, three levels each).  barus (0.5, 0.357)
+  and jfo (0.7, 0.5, to t = 3): film_min correction 0.06 % and 0.53 %.  layer (dense
+  operator only): at (0.7, 0.5) the film_min correction was 1.47 % (levels not monotone at
+  its maximum), at (0.5, 0.357) 0.42 % (t = 1.79); its time error is 0.27 % in film_min
+  (t = 1.07) and 0.75 % in the load at t = 0.01 (the start from rest; 0.01 % from t = 1
+  on).  viscoelastic: NOT converged well below the tolerance in film_min: at (0.5, 0.357)
+  1.07 %, at (0.357, 0.255) 0.67 % (t = 1.87), the three levels' successive differences
+  about 0.5 % each near t = 2 (no h^2 decrease at the exit lobes, y ~ 0.94, where the creep
+  memory is carried on its own uniform grid, `femehl.elastic.viscoelastic.CreepMemory`);
+  film_center 0.23 %, load 0.01 %.  free_indenter: on meshes fitted to the scene itself
+  (`fitted_disk` reads a free indenter's contact from its `gap`, hc(0) = 0.1 held: no
+  contact) the film_min at levels 0.7, 0.5, 0.357 was 0.0379, 0.0354, 0.0372 at t = 1.5
+  (correction 5.5 %); on meshes fitted to `auto_scenes.MESH_SCENES["free_indenter"]` (the
+  imposed gap down to hc = -1.75) 0.51 %.
 """
 
 

@@ -53,10 +53,48 @@ Scenes and why
 ``compressible``, t_end 2
     The paper sphere and motion on a compressible half space HalfSpace(nu = 0.3)
     (compliance 2 (1 - nu) = 1.4): the Boussinesq factor path.
+``layer``, t_end 2
+    The paper sphere and motion on an incompressible elastic layer bonded to a rigid base,
+    ``Layer(thickness=1)`` (nu = 0.5), the thickness of the order of the contact radius
+    (a = 1 on the half space at hc = -1): the layered-solid kernel (a dense operator only,
+    no fast one: the automatic run's cell budget is the dense one), a stiffer, smaller,
+    higher-pressure contact than the half space's at the same indentation.
+``viscoelastic``, t_end 2
+    The paper sphere and motion on a standard linear solid over the half space,
+    ``Viscoelastic(G0=2, tau=0.5)`` (G_inf = 1, the paper's modulus; creep time
+    tau_c = tau G0 / G_inf = 1): the load relaxes during the ramp and the sliding start
+    (t in [1, 2], Deborah number 2 V tau_c / a of order 1), the moving-frame history
+    integral of the relaxing solid.
+``free_indenter``, t_end 2
+    The paper sphere (beta = 200, L = 2) let go at hc(0) = 0.1 at rest as a free indenter
+    ``Motion(mass=0.1, force=4/(3 pi))`` (its weight the Hertz load of hc = -1), no
+    sliding: it falls onto the film, squeezes it and settles towards hc = -1 in a
+    film-damped oscillation (Newton's law, one more row per step; deepest hc = -1.72 at
+    t = 1.34, hc = -0.80 at t = 2).  The load is the film's force, not imposed (it differs
+    from the weight by m hc''), so all three quantities are checked.  Its fitted meshes (the
+    references' and the hand grid's) are fitted to :data:`MESH_SCENES` ``["free_indenter"]``,
+    the same sphere under an imposed gap down to hc = -1.75: ``femehl.discretize.fitted``
+    reads a free indenter's contact from its ``gap``, the initial clearance 0.1 held, so it
+    fits no contact at all (contact radius floored at 0.05 L = 0.1 instead of 1.3), and the
+    references' film_min on those meshes did not converge (levels 0.7, 0.5, 0.357:
+    0.0379, 0.0354, 0.0372 at t = 1.5).
+``jfo``, t_end 3
+    The paper sphere and motion with JFO mass-conserving cavitation
+    (``Fluid(200, cavitation="jfo")``): the cavity behind the contact in the sliding
+    start, the film content carried through it and the film reforming at its rim.  To
+    t = 3, not 2: at t = 2 the minimum film is within 0.1 % of the full-Sommerfeld run's,
+    at t = 3 it is 6 % thicker (the exit constriction then sits on the cavity's rim; load
+    +1.9 %; fitted level 1, dt = 0.02).
+``barus``, t_end 2
+    The paper sphere and motion with Barus pressure-viscosity ``Barus(alpha=10)``
+    (alpha p_max about 2; benchmarks/viscosity.md): against the isoviscous run the minimum
+    film is 20 % thicker at t = 1 and 10 % at t = 2, the central one 45-55 % (fitted level 1,
+    dt = 0.02): the viscosity lagged one step in the Poiseuille flux.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import math
 import pathlib
@@ -64,10 +102,23 @@ import pathlib
 import numpy as np
 
 import femehl
-from femehl import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart, Winkler
+from femehl import (
+    Barus,
+    Domain,
+    Fluid,
+    HalfSpace,
+    Layer,
+    Motion,
+    RampHold,
+    Scene,
+    Sphere,
+    TanhStart,
+    Viscoelastic,
+    Winkler,
+)
 from femehl.problem.indenters import FlatPunch, Shape
 
-__all__ = ["SCENES", "HERTZ_LOAD"]
+__all__ = ["SCENES", "MESH_SCENES", "HERTZ_LOAD", "mesh_scene"]
 
 HERE = pathlib.Path(__file__).resolve().parent
 #: normalized Hertz load of the unit sphere at hc = -1 (incompressible half space)
@@ -174,6 +225,42 @@ def compressible() -> Scene:
     )
 
 
+def _paper_with(**parts) -> Scene:
+    """The paper sphere and motion (beta = 200, L = 2) with some of its parts replaced."""
+    return dataclasses.replace(femehl.presets.paper_sphere(), **parts)
+
+
+def layer() -> Scene:
+    """The paper sphere and motion on Layer(thickness = 1) bonded to a rigid base (nu = 0.5)."""
+    return _paper_with(substrate=Layer(1.0))
+
+
+def viscoelastic() -> Scene:
+    """The paper sphere and motion on Viscoelastic(G0 = 2, tau = 0.5) over the half space."""
+    return _paper_with(substrate=Viscoelastic(G0=2.0, tau=0.5))
+
+
+def free_indenter() -> Scene:
+    """The paper sphere let go at hc(0) = 0.1 at rest: mass 0.1, weight 4/(3 pi), no sliding."""
+    return _paper_with(motion=Motion(gap=0.1, velocity=0.0, mass=0.1, force=HERTZ_LOAD))
+
+
+def free_indenter_mesh() -> Scene:
+    """The scene the free indenter's fitted meshes are fitted to: the paper sphere under an
+    imposed gap down to hc = -1.75 (the free run's deepest is -1.72), no sliding."""
+    return _paper_with(motion=Motion(gap=RampHold(0.1, -1.75, 1.0), velocity=0.0))
+
+
+def jfo() -> Scene:
+    """The paper sphere and motion with JFO cavitation."""
+    return _paper_with(fluid=Fluid(200.0, cavitation="jfo"))
+
+
+def barus() -> Scene:
+    """The paper sphere and motion with Barus(alpha = 10) pressure-viscosity."""
+    return _paper_with(fluid=Fluid(200.0, viscosity=Barus(alpha=10.0)))
+
+
 def _at(f, *args):
     """A no-argument factory ``f(*args)`` (a named function, unlike a lambda in a loop)."""
 
@@ -201,4 +288,19 @@ SCENES: dict = {
     "load_controlled": (load_controlled, 2.0),
     "winkler": (winkler, 2.0),
     "compressible": (compressible, 2.0),
+    "layer": (layer, 2.0),
+    "viscoelastic": (viscoelastic, 2.0),
+    "free_indenter": (free_indenter, 2.0),
+    "jfo": (jfo, 3.0),
+    "barus": (barus, 2.0),
 }
+
+#: name -> factory of the scene its fitted meshes (``fitted_disk(MESH_SCENES[name](), t_end,
+#: level)``) are fitted to, where that is not the scene itself (the references' and the hand
+#: grid's meshes; the automatic runs choose their own)
+MESH_SCENES: dict = {"free_indenter": free_indenter_mesh}
+
+
+def mesh_scene(name: str) -> Scene:
+    """The scene the fitted meshes of scene ``name`` are fitted to."""
+    return MESH_SCENES.get(name, SCENES[name][0])()

@@ -423,6 +423,27 @@ def test_a_closing_on_a_coarse_run_is_retried_finer():
     assert second.level == 1.0
 
 
+def test_a_run_stalled_on_adapted_meshes_goes_on_on_fitted_ones(monkeypatch):
+    """A run on the meshes adapted to the first that stops at the step floor with a film far
+    from closing (JFO's cavitation boundary switching did so) drops the adapted meshes: the
+    same level goes on on the scene-fitted ones, and the answer is theirs."""
+    import femehl.accuracy.auto as auto
+
+    real, stalled = auto._run, []
+
+    def run(scene, method, ladder, *args, **kwargs):
+        if ladder is not auto.LADDERS["fe"] and not stalled:
+            stalled.append(args[1])  # the level
+            raise _closed(0.02, (-0.3, 0.9), "step floor", d_min=0.03, film0=0.1)
+        return real(scene, method, ladder, *args, **kwargs)
+
+    monkeypatch.setattr(auto, "_run", run)
+    res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.05, tol=3e-2, store_every=0)
+    a = res.info["auto"]
+    assert stalled == [a["levels"][1]] and a["adapted_at"] is None and a["reached"]
+    assert not res.disc.dm.name.startswith("adapted")
+
+
 def test_a_closing_confirmed_by_two_levels_is_raised():
     from femehl.accuracy.auto import _closing_confirmed
 

@@ -91,31 +91,6 @@ def _scenes():
 
 
 # ---- step sequences --------------------------------------------------------------------------
-def stretches(t, breaks):
-    """Index ranges ``(i0, i1)`` of ``t`` between the breakpoints (which ``t`` lands on)."""
-    import numpy as np
-
-    t = np.asarray(t)
-    cuts = [0]
-    for b in sorted(breaks):
-        if t[0] < b < t[-1]:
-            i = int(np.argmin(np.abs(t - b)))
-            if abs(t[i] - b) > 1e-9 * max(1.0, b):
-                raise RuntimeError(f"the run does not land on the breakpoint {b}")
-            cuts.append(i)
-    cuts.append(t.size - 1)
-    return list(zip(cuts[:-1], cuts[1:], strict=True))
-
-
-def halved(t, breaks):
-    """Every other time of ``t`` within each stretch between breakpoints, each stretch's end kept
-    (t[0] excluded): the steps of a run with steps twice as long."""
-    keep = []
-    for i0, i1 in stretches(t, breaks):
-        keep += list(range(i0 + 2, i1, 2)) + [i1]
-    return [float(t[i]) for i in sorted(set(keep))]
-
-
 def split(t, k):
     """Every step of ``t`` cut into ``k`` equal parts (t[0] excluded), landing exactly on ``t``."""
     out = []
@@ -129,7 +104,7 @@ def worker(spec: dict) -> dict:
     """The fine run and its five replays (in this process, one after the other)."""
     import numpy as np
 
-    from femehl.accuracy.auto import LADDERS, time_error
+    from femehl.accuracy.auto import LADDERS, every_other_step, time_error
     from femehl.errors import FemehlError
     from femehl.solver.loop import run_scene
     from femehl.solver.stepping import GivenSteps
@@ -163,7 +138,7 @@ def worker(spec: dict) -> dict:
         return out
     out["runs"]["fine"].update(rejected=fine.info.get("rejected_steps"), time_error=time_error(fine).tolist())
     tf = fine.t
-    half = halved(tf, breaks)
+    half = every_other_step(tf, breaks)  # the automatic mode's own
     one("comp2", 2.0 * level, steps=GivenSteps(tf[1:]))
     one("comp2_half", 2.0 * level, steps=GivenSteps(half))
     one("comp_s2", math.sqrt(2.0) * level, steps=GivenSteps(tf[1:]))

@@ -415,28 +415,17 @@ def expert_estimate(res: Result, full, half, ratio, order, adaptive: bool):
     return Estimate(res.t, errors, "controller")
 
 
-def estimate(fine: Result, coarse: Result, ratio: float) -> Estimate:
-    """The pair :class:`~femehl.accuracy.estimate.Estimate` of ``fine`` against ``coarse``:
-    the Richardson check of two runs (the sequence estimates each run from its companions,
-    :func:`one_run_estimate`; before 2026-12-05 it used this).
-
-    ``total`` is the running maximum over the steps so far of the pair estimate
-    (:func:`pair_error`, space and time together): the pair difference changes sign in
-    time, and where it crosses zero the error does not vanish, so the estimate at t is
-    that of the run up to t.  ``time`` is the accumulated local errors of ``fine``
-    (:func:`time_error`) but at most ``total``; ``space = total - time``.
-    """
-    et = time_error(fine)
-    errors = {}
-    for name in QUANTITIES:
-        total = np.maximum.accumulate(pair_error(fine, coarse, name, ratio))
-        tpart = np.minimum(et, total)
-        errors[name] = {"total": total, "space": total - tpart, "time": tpart}
-    levels = tuple(float(r.info["level"]) for r in (fine, coarse) if "level" in r.info)
-    return Estimate(fine.t, errors, "pair", ratio, levels)
-
-
 # ---- the driver --------------------------------------------------------------------------
+def _discretization(ladder, scene, t_end, level, options) -> tuple:
+    """``(disc, callback, controls)``: the options of a run at ``level`` on ``ladder`` (BDF2
+    unless the caller chose a scheme), split from the state callback and the step controls."""
+    from femehl.solver.adaptive import CONTROLS
+
+    disc = {"scheme": "bdf2", **ladder.options(scene, t_end, level), **options}
+    on_state = disc.pop("callback", None)
+    return disc, on_state, {k: disc.pop(k) for k in CONTROLS if k in disc}
+
+
 def _run(
     scene,
     method,
@@ -460,13 +449,10 @@ def _run(
     ``deadline`` (``time.perf_counter()``) raises :class:`_OutOfTime`.  ``progress(desc,
     t_end, t_start)``, when given, makes a State handler with a ``close()`` (a progress bar).
     """
-    from femehl.solver.adaptive import CONTROLS
     from femehl.solver.loop import run_scene
 
     t0 = time.perf_counter()
-    disc = {"scheme": "bdf2", **ladder.options(scene, t_end, level), **options}
-    on_state = disc.pop("callback", None)
-    controls = {k: disc.pop(k) for k in CONTROLS if k in disc}
+    disc, on_state, controls = _discretization(ladder, scene, t_end, level, options)
     sink = None if plan is None else folder
     if sink is None and deadline is not None:
         on_state = _deadline_guard(deadline, on_state)
@@ -503,16 +489,12 @@ def _estimate(scene, method, ladder, t_end, level, options, run) -> Estimate | N
     times its ``level`` on ``ladder`` (None, logged, when they stop); their wall time in
     ``run.info["estimate_wall"]``.  ``run`` has ``t``, the :data:`QUANTITIES` and ``info``."""
     from femehl.errors import MeshError
-    from femehl.solver.adaptive import CONTROLS
     from femehl.solver.loop import make_stepper
 
     t0 = time.perf_counter()
     level_c = COMPANION_RATIO * level
     try:
-        disc = {"scheme": "bdf2", **ladder.options(scene, t_end, level_c), **options}
-        for key in ("callback", *CONTROLS):
-            disc.pop(key, None)
-        stepper = make_stepper(scene, method, **disc)
+        stepper = make_stepper(scene, method, **_discretization(ladder, scene, t_end, level_c, options)[0])
     except MeshError as exc:  # a mesh this coarse may not be made
         logger.warning("femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, exc)
         return None

@@ -1,7 +1,7 @@
 """The one error-estimate type: :class:`Estimate` (docs/design.md sections 8 and 9).
 
 Made in :mod:`femehl.accuracy.auto` only (:func:`~femehl.accuracy.auto.one_run_estimate`,
-:func:`~femehl.accuracy.auto.expert_estimate`, :func:`~femehl.accuracy.auto.estimate`); read by
+:func:`~femehl.accuracy.auto.expert_estimate`); read by
 :meth:`femehl.output.result.Result.uncertainty` and written by
 :func:`femehl.output.table.add_error_columns`.
 """
@@ -19,9 +19,9 @@ __all__ = ["Estimate", "PARTS", "HOWS"]
 
 #: the parts of each quantity's estimate
 PARTS = ("total", "space", "time")
-#: how an estimate was made: a run's coarser companions (its space and time parts), its
-#: step controller only (time), or a Richardson pair of two runs (the check)
-HOWS = ("companion", "controller", "pair")
+#: how an estimate was made: a run's coarser companions (its space and time parts), or its
+#: step controller only (time)
+HOWS = ("companion", "controller")
 
 
 @dataclass(frozen=True)

@@ -66,6 +66,13 @@ class StepController:
         f = self.safety * (self.tol / err) ** (1.0 / p)
         return min(top, max(self.fac_min, f))
 
+    def kink_factor(self, err: float, dt: float) -> float:
+        """The factor after a second rejection of one step, whose error did not fall as
+        ``dt^p``: a kink's (the contact edge crossing a node), whose local error falls only as
+        ``dt``, so per unit time it is flat above ``UNIT_STEP`` and ``~ dt`` below."""
+        f = self.safety * (self.tol / err) * min(dt, UNIT_STEP) / dt
+        return min(1.0, max(self.fac_min, f))
+
 
 @dataclass
 class _Run:
@@ -433,8 +440,8 @@ class AdaptiveSteps:
         else:
             run.streak += 1
             f = ctl.factor(err, p, grow=False, dt=h)
-            if run.streak > 1:  # the estimate is not asymptotic here: cut hard
-                f = min(f, ctl.fac_min)
+            if run.streak > 1:  # the estimate is not asymptotic here: a kink's, first order per step
+                f = ctl.kink_factor(err, h)
             _reject(run, 1, max(h * f, dt_min), f"error {err:.3g} > tol", t_new, h)
 
     def _arrived(self):

@@ -266,6 +266,21 @@ def test_mesh_edge_terms_reproduce_triangle_influence(random_mesh):
     assert np.all(triangle_influence(P, tri) >= 0)
 
 
+def test_edge_terms_mirror_is_the_mirrored_edges_subtracted(random_mesh):
+    """``mirror=True`` (a half disk's image, seen from A mirrored) equals the terms of the
+    edges mirrored in y = 0 subtracted, to round-off; and S^T T is then the influence of
+    the triangles minus... plus their images (orientation reversed)."""
+    P, t, rng = random_mesh
+    edges, S = mesh_edges(t, P)
+    pts = np.vstack([P, rng.random((30, 2)) * 2.0 - 0.5])
+    img = P * np.array([1.0, -1.0])
+    T = edge_terms(pts, P, edges, mirror=True)
+    np.testing.assert_allclose(T, edge_terms(pts, P, edges) - edge_terms(pts, img, edges), rtol=0, atol=1e-13)
+    tri = np.transpose(P[t], (1, 0, 2))
+    X = triangle_influence(pts, tri) + triangle_influence(pts, tri * np.array([1.0, -1.0]))
+    np.testing.assert_allclose(np.asarray((S.T @ T.T).T), X, rtol=1e-10, atol=1e-12)
+
+
 def test_influence_matrix_mirror():
     """mirror_y adds I(A, image of T): equal to triangle_influence of the reflected triangles."""
     pts = np.array([[0.3, 0.2], [0.0, 0.0], [1.0, 0.0]])

@@ -259,14 +259,11 @@ class FEDisc(P1P0):
         ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
         SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse
-        mirror = self.nodes * np.array([1.0, -1.0])
         C = np.empty((ne, self.n))
         block = max(1, int(2**26 // (8 * edges.shape[0])))
         for s in range(0, ne, block):
             e = slice(s, min(s + block, ne))
-            T = edge_terms(self.centroids[e], self.nodes, edges)
-            if self.half:
-                T -= edge_terms(self.centroids[e], mirror, edges)
+            T = edge_terms(self.centroids[e], self.nodes, edges, mirror=self.half)
             C[e] = (SP.T @ T.T).T
         return C
 

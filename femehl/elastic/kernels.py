@@ -11,6 +11,9 @@ section 14.
 
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
 
 __all__ = [
@@ -198,42 +201,58 @@ def mesh_edges(t, nodes):
     return edges, S
 
 
-def edge_terms(points, nodes, edges, out=None):
+def edge_terms(points, nodes, edges, out=None, mirror=False):
     """``T[i, k] = h (asinh(sC/|h|) - asinh(sB/|h|))`` for A = points[i], edge k = (B, C).
 
     The same quantity as the per-edge term of :func:`triangle_influence`,
     written with the vertex distances rho = |B - A|, |C - A| as
     ``h * log((sC + rhoC)/(sB + rhoB))`` (or its mirror form when the foot of
     A lies beyond C, to avoid cancellation), so each term costs one log.
+    ``mirror``: minus the term of the edge mirrored in ``y = 0`` (a half disk's image),
+    which is the term seen from A mirrored, ``(x, -y)``.
     """
-    pts = np.asarray(points, dtype=float).reshape(-1, 2)
-    nodes = np.asarray(nodes, dtype=float)
-    edges = np.asarray(edges)
-    B, C = edges[:, 0], edges[:, 1]
-    e = nodes[C] - nodes[B]
-    le = np.hypot(e[:, 0], e[:, 1])
-    ex, ey = e[:, 0] / le, e[:, 1] / le
-    nE = edges.shape[0]
+    pts = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
+    nodes = np.ascontiguousarray(np.asarray(nodes, dtype=float))
+    edges = np.asarray(edges, dtype=np.int64)
     if out is None:
-        out = np.empty((pts.shape[0], nE))
-    rows = max(1, _BLOCK_BYTES // (8 * 6 * max(nE, nodes.shape[0])))
-    for s in range(0, pts.shape[0], rows):
-        sl = slice(s, min(s + rows, pts.shape[0]))
-        dx = nodes[None, :, 0] - pts[sl, 0:1]  # (rows, nn): vertex - A
-        dy = nodes[None, :, 1] - pts[sl, 1:2]
-        rho = np.hypot(dx, dy)
-        bx, by = dx[:, B], dy[:, B]
-        h = bx * ey - by * ex
-        sb = bx * ex + by * ey
-        sc = sb + le
-        rb, rc = rho[:, B], rho[:, C]
-        flip = (sb + sc) < 0.0
-        num = np.where(flip, rb - sb, sc + rc)
-        den = np.where(flip, rc - sc, sb + rb)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            val = h * np.log(num / den)
-        val[~(np.abs(h) > 1e-14 * le)] = 0.0
-        out[sl] = val
+        out = np.empty((pts.shape[0], edges.shape[0]))
+    B, C = (np.ascontiguousarray(edges[:, k]) for k in (0, 1))
+    return _edge_rows(pts, nodes, B, C, bool(mirror), out)
+
+
+@numba.njit(cache=True, boundscheck=False)
+def _edge_rows(pts, nodes, B, C, mirror, out):  # pragma: no cover - compiled
+    nE = B.shape[0]
+    le = np.empty(nE)
+    ex = np.empty(nE)
+    ey = np.empty(nE)
+    for k in range(nE):
+        x = nodes[C[k], 0] - nodes[B[k], 0]
+        y = nodes[C[k], 1] - nodes[B[k], 1]
+        le[k] = math.hypot(x, y)
+        ex[k] = x / le[k]
+        ey[k] = y / le[k]
+    rho = np.empty(nodes.shape[0])
+    for i in range(pts.shape[0]):
+        ax = pts[i, 0]
+        for m in range(2 if mirror else 1):
+            ay = pts[i, 1] if m == 0 else -pts[i, 1]
+            for j in range(nodes.shape[0]):
+                rho[j] = math.hypot(nodes[j, 0] - ax, nodes[j, 1] - ay)
+            for k in range(nE):
+                bx = nodes[B[k], 0] - ax
+                by = nodes[B[k], 1] - ay
+                h = bx * ey[k] - by * ex[k]
+                val = 0.0
+                if abs(h) > 1e-14 * le[k]:
+                    sb = bx * ex[k] + by * ey[k]
+                    sc = sb + le[k]
+                    if sb + sc < 0.0:
+                        val = h * math.log((rho[B[k]] - sb) / (rho[C[k]] - sc))
+                    else:
+                        val = h * math.log((sc + rho[C[k]]) / (sb + rho[B[k]]))
+                # the mirrored edge seen from A is minus this edge seen from A mirrored
+                out[i, k] = val if m == 0 else out[i, k] + val
     return out
 
 

@@ -760,6 +760,13 @@ def solve_to_tolerance(
             # the cell budget's fit is the finest level there is; the time budget's is
             # asked again after the run (a run cheaper than predicted leaves time for more)
             level, last, stopped = fit, why == "cell budget", why
+        if runs:  # what the next run will cost, before it starts (max_wall= bounds it)
+            logger.info(
+                "auto: next, level %.3g (about %.0f cells), predicted to take about %.0f s",
+                level,
+                cells(level),
+                predicted_wall(runs, cells(level), level),
+            )
         # the first run, when meshes are then adapted to it: in memory, not the answer
         seeds = not runs and ladder.adapt is not None
         plan = None if seeds else _plan(tol, level, tol_t, t_end, ladder)

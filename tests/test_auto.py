@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import math
 import pathlib
 
 import numpy as np
@@ -445,6 +446,34 @@ def test_a_run_stalled_on_adapted_meshes_goes_on_on_fitted_ones(monkeypatch):
     a = res.info["auto"]
     assert stalled == [a["levels"][1]] and a["adapted_at"] is None and a["reached"]
     assert not res.disc.dm.name.startswith("adapted")
+
+
+def test_a_run_stalled_on_fitted_meshes_is_followed_by_a_coarser_one(monkeypatch):
+    """A run that stalls (step floor, film far from closing) on the fitted meshes is not a
+    film that closes: a finer mesh stalls sooner (JFO), so the level halfway in log to the
+    last finished run goes on; when that is within BUDGET_RATIO of it, the sequence ends
+    with the last finished run, stopped at the "step floor"."""
+    import femehl.accuracy.auto as auto
+
+    real, tried = auto._run, []
+
+    def run(scene, method, ladder, t_end, level, *args, **kwargs):
+        if tried or level < 2.0:  # every run after the first stalls
+            tried.append(level)
+            raise _closed(0.02, (-0.3, 0.9), "step floor", d_min=0.03, film0=0.1)
+        tried.append(level)
+        return real(scene, method, ladder, t_end, level, *args, **kwargs)
+
+    monkeypatch.setattr(auto, "_run", run)
+    res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.05, tol=1e-4, store_every=0)
+    a = res.info["auto"]
+    assert a["stopped"] == "step floor" and not a["reached"] and a["levels"] == [2.0]
+    first, adapted, fitted, *halves = tried
+    assert first == 2.0 and adapted == fitted < 2.0  # the adapted meshes, then the fitted ones
+    previous = [fitted, *halves[:-1]]
+    assert halves
+    assert all(h == pytest.approx(math.sqrt(2.0 * p)) for h, p in zip(halves, previous, strict=True))
+    assert 2.0 / halves[-1] >= auto.BUDGET_RATIO and 2.0 / math.sqrt(2.0 * halves[-1]) < auto.BUDGET_RATIO
 
 
 def test_a_closing_confirmed_by_two_levels_is_raised():

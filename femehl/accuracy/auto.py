@@ -708,8 +708,8 @@ def solve_to_tolerance(
     Returns the finest run (a :class:`~femehl.output.result.Result`) with ``result.estimate``
     (docs/design.md section 9 for the estimators) and ``result.info["auto"]``: ``tol``,
     ``reached`` (the estimate is <= :data:`ACCEPT` * ``tol``), ``accept``, ``stopped``
-    (None, ``"cell budget"`` or ``"time budget"``: what ended a sequence that did not
-    reach ``tol``), ``levels``, ``elements``, ``steps``,
+    (None, ``"cell budget"``, ``"time budget"``, ``"time tolerance floor"`` or ``"step
+    floor"``: what ended a sequence that did not reach ``tol``), ``levels``, ``elements``, ``steps``,
     ``rejected_steps``, ``tol_t`` and ``wall`` of every run, and the largest estimated
     ``total``, ``space`` and ``time`` errors.  ``level`` is the first (coarsest) level;
     ``max_elements`` the cell budget (default: :func:`cell_budget` of the scene's
@@ -814,6 +814,20 @@ def solve_to_tolerance(
                 ladder, adapted_at = fitted, None
                 cells = ladder.cells_of(scene, t_end)
                 continue
+            if runs and _stalled(exc):  # a finer mesh stalls sooner: halfway to the last run
+                between = math.sqrt(float(runs[-1].info["level"]) * level)
+                if between < float(runs[-1].info["level"]) / BUDGET_RATIO:
+                    logger.warning(
+                        "auto: the run at level %.3g stopped at the step floor with a film that was "
+                        "not closing (%s): level %.3g, halfway to the last finished run, goes on",
+                        level,
+                        exc,
+                        between,
+                    )
+                    level = between
+                    continue
+                stopped = "step floor"
+                break
             failed = _closing_confirmed(failed, exc, level, t_end)
             level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
             tol_t = min(tol_t, time_tolerance(level))

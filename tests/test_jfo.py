@@ -278,3 +278,25 @@ def test_free_indenter_and_the_tracked_elastic_products():
     direct = femehl.solve(sc, t_end=2.0, dt=0.02, mesh="coarse", estimate=False, linear_solver="lu")
     assert state.film_min == pytest.approx(direct.final.film_min, rel=1e-5)
     assert state.hc == pytest.approx(direct.final.hc, rel=1e-6)
+
+
+def test_the_step_estimate_leaves_out_the_cells_whose_nodes_switch():
+    """JFO's lagged set switches a node on the cavity's edge about every step, and the film
+    there jumps whatever the step: the adaptive steps read the film on the other cells
+    (``JFOCavitation.settled_cells``).  On the paper case's coarse mesh, a node switched
+    between two states marks exactly the cells around it; no switch: all cells (None)."""
+    from femehl.api import make_stepper
+    from femehl.problem.cavitation import JFOCavitation
+
+    scene = dataclasses.replace(femehl.presets.paper_sphere(), fluid=Fluid(200.0, cavitation="jfo"))
+    stepper = make_stepper(scene, "fe", mesh="coarse", scheme="bdf2")
+    disc = stepper.disc
+    s0 = stepper.initial_state().with_own(p_aux=np.ones(disc.n))
+    assert JFOCavitation.settled_cells(disc, [s0, s0]) is None
+    k = disc.n // 2
+    y = np.ones(disc.n)
+    y[k] = -1.0
+    keep = JFOCavitation.settled_cells(disc, [s0, s0.with_own(p_aux=y)])
+    node = disc.free_index[k]
+    around = np.any(disc.basis.mesh.t == node, axis=0)
+    assert keep.shape == (disc.basis.mesh.t.shape[1],) and np.array_equal(~keep, around)

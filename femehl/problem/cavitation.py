@@ -375,6 +375,24 @@ class JFOCavitation(_Model):
         info["theta_min"] = 1.0
         return info
 
+    @staticmethod
+    def settled_cells(disc, states):
+        """The cells none of whose nodes changed between full and cavitated over ``states``
+        (None: all of them), for the adaptive steps' error estimate: where the lagged set
+        switches a node on the cavity's edge, the film there jumps whatever the step."""
+        sets = [np.asarray(s.own["p_aux"]) < 0.0 for s in states if s.own.get("p_aux") is not None]
+        P = getattr(disc, "P", None)
+        if len(sets) < 2 or P is None:
+            return None
+        changed = np.zeros(sets[0].size, dtype=bool)
+        for later in sets[1:]:
+            changed |= later != sets[0]
+        if not changed.any():
+            return None
+        nodes = np.zeros(P.shape[1])
+        nodes[disc.free_index] = changed
+        return np.asarray(P @ nodes).ravel() == 0.0
+
     def prepare(self, stepper, op, rhs_list, state, ctx):
         """The switched system: ``p`` or the gas ``v`` at each node, the set from ``state``."""
         from femehl.solver.linsolve import SwitchedOperator

@@ -98,6 +98,9 @@ class _Run:
     origin: float = -math.inf
     stops: list = field(default_factory=list)  # the breakpoints ahead, then t_end
     trial: tuple = (math.nan, math.nan)  # the trial step proposed: (t_new, h)
+    #: ``settled(states)``: the film points the estimate reads (None: all), from the fluid's
+    #: cavitation model (JFO: not the cells whose nodes switched set)
+    settled: object = None
 
 
 @dataclass(frozen=True)
@@ -135,7 +138,11 @@ def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) 
     """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (docs/design.md section 3.1);
     the film alone when ``load_pred`` is None."""
     d = np.asarray(trial.d, dtype=float)
-    err = float(np.max(np.abs(d - d_pred) / d)) if d.size else 0.0
+    rel = np.abs(d - d_pred) / d
+    keep = None if run.settled is None else run.settled([*run.levels, trial])
+    if keep is not None and keep.shape == rel.shape and keep.any():
+        rel = rel[keep]
+    err = float(np.max(rel)) if rel.size else 0.0
     if load_pred is None:
         return err
     load = _load(trial)
@@ -347,7 +354,10 @@ class AdaptiveSteps:
         self._stepper, self._order = stepper, _order(stepper)
         self._ctl = StepController(self.tol, self.safety)
         self._dt0, self._dt_min, self._dt_max, self._eps, self._t_end = dt0, dt_min, dt_max, eps, t_end
+        cells = getattr(getattr(stepper, "cavitation", None), "settled_cells", None)
+        disc = getattr(stepper, "disc", None)
         self._run = _Run(
+            settled=None if cells is None else (lambda states: cells(disc, states)),
             dt=dt0,
             levels=[without_history(state)],
             load_scale=abs(_load(state)),

@@ -560,17 +560,17 @@ def _fitted_to(ladder: Ladder, t_fit: float) -> Ladder:
     return Ladder(lambda sc, _t, lv: ladder.options(sc, t_fit, lv), ladder.cells, ladder.keys)
 
 
-def _next_run(level: float, tol_t: float, est: Estimate | None, tol: float, hi: float = RATIO_MAX) -> tuple:
+def _next_run(level: float, tol_t: float, est: Estimate | None, tol: float) -> tuple:
     """The next run's level and time tolerance: its space error aimed at ``(1 - TIME_SHARE)
-    * SAFETY * tol`` (order 2 in the level, at most ``hi`` times finer, never coarser),
+    * SAFETY * tol`` (order 2 in the level, at most :data:`RATIO_MAX` times finer, never coarser),
     its time error at ``TIME_SHARE * SAFETY * tol`` (about proportional to ``tol_t``,
     changed by a factor within :data:`TAU_STEP`)."""
-    if est is None:  # no estimate (the companions stopped): hi times finer in both
-        return level / hi, max(TAU_RANGE[0], tol_t / hi**2)
+    if est is None:  # no estimate (the companions stopped): RATIO_MAX times finer in both
+        return level / RATIO_MAX, max(TAU_RANGE[0], tol_t / RATIO_MAX**2)
     aim = SAFETY * tol
     space, slow = est.worst("space"), est.worst("time")
     ratio = math.sqrt(space / ((1.0 - TIME_SHARE) * aim)) if space > 0 else 1.0
-    ratio = min(hi, max(1.0, ratio))
+    ratio = min(RATIO_MAX, max(1.0, ratio))
     factor = TIME_SHARE * aim / slow if slow > 0 else TAU_STEP[1]
     factor = min(TAU_STEP[1], max(TAU_STEP[0], factor))
     return level / ratio, min(TAU_RANGE[1], max(TAU_RANGE[0], tol_t * factor))
@@ -926,10 +926,11 @@ def _adapted(ladder: Ladder, res: Result, scene, t_end: float) -> Ladder | None:
 
 
 def _stalled(exc) -> bool:
-    """A run stopped at the step floor with a film far from closing (its error estimate does
-    not fall with the step: JFO's cavitation boundary switching between two cells of a
-    mesh adapted to the first run stalled so at t = 1.68 of the benchmark's JFO scene,
-    where the fitted mesh of the same level runs through in 375 steps)."""
+    """A run stopped at the step floor with a film far from closing: its error estimate did
+    not fall with the step (JFO's cavitation boundary switching between two cells stalled
+    the benchmark's JFO scene so on meshes adapted to its first run, and on fitted ones of
+    5,000 cells and more before its step estimate left those cells out); not a film that
+    closes, so a finer mesh does not decide it."""
     d_min, film0 = getattr(exc, "d_min", math.nan), getattr(exc, "film0", math.nan)
     return getattr(exc, "reason", "") == "step floor" and d_min > CLOSED_FILM * film0
 

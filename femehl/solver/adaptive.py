@@ -140,7 +140,7 @@ def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) 
     d = np.asarray(trial.d, dtype=float)
     rel = np.abs(d - d_pred) / d
     keep = None if run.settled is None else run.settled([*run.levels, trial])
-    if keep is not None and keep.shape == rel.shape and keep.any():
+    if keep is not None and keep.any():
         rel = rel[keep]
     err = float(np.max(rel)) if rel.size else 0.0
     if load_pred is None:

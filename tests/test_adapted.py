@@ -109,3 +109,25 @@ def test_a_full_disk_run_and_the_plan_round_trip():
     assert mesh.half is False and mesh.mesh.t.shape[1] == pytest.approx(800, rel=0.3)
     again = _ladder_of("fe", {"level": 1.0, **ladder.record})
     assert np.array_equal(again.options(scene, 0.3, 1.0)["mesh"].mesh.p, mesh.mesh.p)
+
+
+def test_a_linear_size_field_is_read_by_gmsh_as_it_is_by_python(source):
+    """LinearSizes: exact on a linear field, its largest value outside the triangles; gmsh's
+    mesh under it (a background view) is the mesh of the same sizes given as a callback,
+    and its element sizes follow the field (h = 0.06 at x = -2 to 0.18 at x = 2)."""
+    from femehl.discretize.mesh import LinearSizes
+
+    p, t = source.mesh.p, source.mesh.t
+    field = LinearSizes(p, t, 0.12 + 0.03 * p[0], far=0.3)
+    for x, y in [(0.3, 0.7), (-1.2, 0.1), (1.0, 1.2)]:
+        assert field(x, y) == pytest.approx(0.12 + 0.03 * x, rel=1e-12)
+    assert field(0.0, -0.5) == 0.3  # below the half disk: outside every triangle
+    # a constant field: the cells of the constant callback (gmsh also reads the view on the
+    # sliver between the source's polygon and the arc, where a call gives far)
+    const = sized_disk(2.0, True, LinearSizes(p, t, np.full(p.shape[1], 0.12), far=0.3))
+    assert const.mesh.t.shape[1] == sized_disk(2.0, True, lambda x, y: 0.12).mesh.t.shape[1]
+    view = sized_disk(2.0, True, field)
+    c, a = centroids(view), areas(view)
+    left, right = a[np.abs(c[:, 0] + 1.0) < 0.2], a[np.abs(c[:, 0] - 1.0) < 0.2]
+    # sizes 0.09 and 0.15 at x = -1 and 1: area ratio (0.15 / 0.09)^2 = 2.78
+    assert np.median(right) / np.median(left) == pytest.approx(2.78, rel=0.15)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from femehl.discretize.mesh import DiskMesh, sized_disk
+from femehl.discretize.mesh import DiskMesh, LinearSizes, sized_disk
 from femehl.errors import MeshError, SceneError
 
 __all__ = ["AdaptedSizes", "adapted_sizes", "curvature_indicator"]
@@ -111,20 +111,11 @@ class AdaptedSizes:
         level = _check_level(level)
         return _cells(self.nodes, self.triangles, self.s * level)
 
-    def size(self, level: float = 1.0):
-        """``h(x, y)`` at ``level``: the linear interpolant of ``level * s``."""
-        import matplotlib.tri as mtri
-
+    def size(self, level: float = 1.0) -> LinearSizes:
+        """``h(x, y)`` at ``level``: the linear interpolant of ``level * s`` (its largest
+        value outside the run's triangles)."""
         level = _check_level(level)
-        tri = mtri.Triangulation(self.nodes[0], self.nodes[1], self.triangles.T)
-        interp = mtri.LinearTriInterpolator(tri, self.s * level)
-        far = float(np.max(self.s) * level)
-
-        def h(x, y):
-            v = interp(x, y)
-            return far if np.ma.is_masked(v) else float(v)
-
-        return h
+        return LinearSizes(self.nodes, self.triangles, self.s * level, float(np.max(self.s) * level))
 
     def record(self) -> dict:
         """The field as JSON-able lists (a run folder's plan), :meth:`from_record` reads it."""

@@ -662,10 +662,15 @@ class RecycledGCR:
             # 44,792 elements)
             f = None
             f = self._refactor(op, t)
-        t0 = time.perf_counter()
-        x, Cx, gen, its, dirs = self._krylov(op, G, b, bnorm, f)
-        self.info["krylov_iterations"] += its
-        self.info["krylov_s"] += time.perf_counter() - t0
+        x, Cx, gen, its, dirs = self._timed_krylov(op, G, b, bnorm, f)
+        if x is None and fresh and (self.solutions or self.directions):
+            # the recycled space's rounding, not the preconditioner: the true residual stalls
+            # while the recursive one falls to 1e-13 (a combination of nearly collinear
+            # solutions of earlier steps at small dt: a free indenter's first steps on the
+            # fast operator stalled at 7e-8 against rtol 1e-9 and stopped the run)
+            self.solutions, self._solution_ages, self.directions = [], [], []
+            self.info["recycle_resets"] = self.info.get("recycle_resets", 0) + 1
+            x, Cx, gen, its, dirs = self._timed_krylov(op, G, b, bnorm, f)
         if x is None:
             if fresh and op.fast:
                 raise SingularSystemError(
@@ -691,6 +696,13 @@ class RecycledGCR:
             f.solves += 1
             f.stale = marginal > f.total / f.solves
         return x, Cx
+
+    def _timed_krylov(self, op, G, b, bnorm, f):
+        t0 = time.perf_counter()
+        x, Cx, gen, its, dirs = self._krylov(op, G, b, bnorm, f)
+        self.info["krylov_iterations"] += its
+        self.info["krylov_s"] += time.perf_counter() - t0
+        return x, Cx, gen, its, dirs
 
     @property
     def rtol(self) -> float:

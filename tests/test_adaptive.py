@@ -410,3 +410,26 @@ def test_run_loop_takes_a_step_policy_alone():
     for kw in (dict(dt=0.1), dict(step_tol=1e-3), dict(dt_max=0.5)):
         with pytest.raises(SceneError, match="whole step policy"):
             run_loop(ScalarODE(), 1.0, steps=GivenSteps([1.0]), **kw)
+
+
+def test_given_steps_cut_a_failing_step_in_two_when_asked():
+    """The paper case's indentation on the coarse mesh in steps of 0.25: the film goes
+    negative at the first (FilmRuptureError); with halvings the failing step is cut in two
+    (0.125 passes) and the run then lands on every given time: the run of the given times
+    with 0.125 added, to the linear solver's tolerance."""
+    import femehl
+    from femehl.solver.loop import make_stepper
+
+    stepper = make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse", scheme="bdf2")
+    times = [0.25, 0.5, 0.75, 1.0]
+    with pytest.raises(femehl.FilmRuptureError):
+        run_loop(stepper, 1.0, store_every=0, steps=GivenSteps(times))
+    policy = GivenSteps(times, halvings=3)
+    res = run_loop(stepper, 1.0, store_every=0, steps=policy)
+    assert policy.cut == 1
+    np.testing.assert_allclose(res.t, [0.0, 0.125, *times], rtol=1e-12)
+    same = run_loop(stepper, 1.0, store_every=0, steps=GivenSteps([0.125, *times]))
+    for q in ("film_min", "film_center", "load"):
+        np.testing.assert_allclose(getattr(res, q), getattr(same, q), rtol=1e-6)
+    with pytest.raises(SceneError, match="halvings"):
+        GivenSteps(times, halvings=-1)

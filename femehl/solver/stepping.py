@@ -181,13 +181,18 @@ class GivenSteps(_Planned):
     """The step policy that lands on given ``times`` (e.g. another run's, so that two
     discretizations are compared at the same steps), then on ``t_end``.  As adaptive steps
     do, the history is dropped at the motion's breakpoints and at ``start`` (a backward-Euler
-    step follows); a step that fails raises."""
+    step follows).  A step that fails raises, or with ``halvings = k`` is cut in two, up to
+    ``k`` times (:attr:`cut`: how many were)."""
 
-    def __init__(self, times):
+    def __init__(self, times, halvings: int = 0):
         ts = np.asarray(times, dtype=float).ravel()
         if ts.size == 0 or not np.all(np.isfinite(ts)) or np.any(np.diff(ts) <= 0.0):
             raise SceneError("times must be a non-empty increasing sequence of finite times.")
+        if isinstance(halvings, bool) or not isinstance(halvings, int) or halvings < 0:
+            raise SceneError(f"halvings must be an integer >= 0, got {halvings!r}.")
         self.times = ts
+        self.halvings = halvings
+        self.cut = 0
 
     def begin(self, stepper: Stepper, t_end: float, start: State | None) -> State:
         from femehl.validation import check_positive
@@ -198,9 +203,11 @@ class GivenSteps(_Planned):
             raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
         eps = 1e-12 * max(1.0, abs(t_end))
         self._stops = [float(t) for t in self.times if state.t + eps < t < t_end - eps] + [t_end]
+        self._depth = [0] * len(self._stops)
         scene = getattr(stepper, "scene", None)
         self._breaks = [b for b in breakpoints_of(scene) if state.t + eps < b < t_end - eps]
         self._eps, self._last = eps, state
+        self.cut = 0
         return state
 
     def propose(self):
@@ -211,8 +218,26 @@ class GivenSteps(_Planned):
             base = without_history(base)
         return base, t_new, t_new - base.t
 
+    def judge(self, trial: State | None, failure: Exception | None):
+        if failure is None:
+            try:
+                _check_film(trial)
+            except FilmRuptureError as exc:
+                failure = exc
+        depth = self._depth[0]
+        if failure is not None:
+            if depth >= self.halvings:
+                raise failure
+            self._stops.insert(0, 0.5 * (self._last.t + self._stops[0]))
+            self._depth[:1] = [depth + 1, depth + 1]
+            self.cut += 1
+            return
+        self._accepted(trial)
+        yield trial
+
     def _accepted(self, trial: State) -> None:
         self._stops.pop(0)
+        self._depth.pop(0)
         self._last = trial
 
 

@@ -527,6 +527,27 @@ class DirectSolver:
 #: fixed-dt run changes ``c_0`` only at its first BDF2 step (``a0`` from 1 to 3/2).
 KEY_CHANGE = 1.0
 
+#: the preconditioner's refresh balances its cost against the iterations it saves, both
+#: counted in preconditioned iterations (a model, not the clock: with measured times two
+#: runs of the same scene refreshed 26, 27 and 31 times and their films differed by 1e-4,
+#: the adaptive steps following the solves' rounding).  Dense path: a single-precision LU
+#: of n unknowns against an iteration's ``C z`` of ne x n, ``DENSE_KAPPA n^2 / ne`` and at
+#: least ``DENSE_FACTOR_MIN``: twice the measured ratio (one BLAS thread, this machine: 24,
+#: 17, 24, 39 iterations at n = 800, 1,500, 3,000, 5,000 with ne = 2 n), which made the
+#: paper case's automatic answer (5,986 cells) 18.2 s against 19.1 s at the ratio itself
+#: (15 refreshes and 855 iterations against 24 and 753; means of 3 and 4 runs); fast path:
+#: ``FAST_FACTOR`` (the near-field LU and the coarse correction: 7.1 and 8.1 on 11,450 and
+#: 23,268 elements)
+DENSE_KAPPA, DENSE_FACTOR_MIN, FAST_FACTOR = 0.032, 40.0, 8.0
+
+
+def factor_cost(op) -> float:
+    """The preconditioner's factorization of ``op`` in preconditioned iterations."""
+    if op.fast:
+        return FAST_FACTOR
+    n, ne = op.D.shape[0], max(1, op.C.shape[0])
+    return max(DENSE_FACTOR_MIN, DENSE_KAPPA * n * n / ne)
+
 
 def _key_moved(factored: float, now: float) -> bool:
     """``c_0`` fell by more than ``KEY_CHANGE`` times its new value since the LU."""
@@ -537,7 +558,7 @@ def _key_moved(factored: float, now: float) -> bool:
 class _Factor:
     lu: object  # the preconditioner: DenseLU, SwitchedLU or PermutedLU (``.solve(r)``)
     key: float  # op.key of the factorized matrix
-    total: float  # cost of this factor's cycle: factorization + preconditioned iterations
+    total: float  # cost of this factor's cycle in iterations: factorization + iterations
     solves: int = 0  # solves of this cycle
     stale: bool = False  # refresh at the next solve
 
@@ -626,7 +647,6 @@ class RecycledGCR:
         self._solution_ages: list = []  # generations of tracking behind their C x
         self._probe = None  # (w, w^T C): checks a tracked C x at the cost of two dot products
         self.directions: list = []  # recent preconditioned (z, C z)
-        self.t_iter = 0.0  # wall time of one preconditioned iteration (s)
         self.history: list = []  # relative residuals of the last solve
         self.info = {"factorizations": 0, "factor_s": 0.0, "krylov_iterations": 0, "krylov_s": 0.0}
         self._own_factorizations = 0  # preconditioner LUs (the direct fallback counts its own)
@@ -691,10 +711,9 @@ class RecycledGCR:
         if self.refactor_after is not None:
             f.stale = its > self.refactor_after
         else:
-            marginal = its * self.t_iter
-            f.total += marginal
+            f.total += its  # in preconditioned iterations: no clock, the same run every time
             f.solves += 1
-            f.stale = marginal > f.total / f.solves
+            f.stale = its > f.total / f.solves
         return x, Cx
 
     def _timed_krylov(self, op, G, b, bnorm, f):
@@ -731,11 +750,10 @@ class RecycledGCR:
                 lu = TwoLevel(lu, *coarse, t)
         else:
             lu = op.factorize(self.precond_dtype, t)
-        cost = time.perf_counter() - t0
         self._own_factorizations += 1
-        self._own_factor_s += cost
+        self._own_factor_s += time.perf_counter() - t0
         self._sync()
-        self.factor = _Factor(lu, op.key, total=cost)
+        self.factor = _Factor(lu, op.key, total=factor_cost(op))
         return self.factor
 
     def _precondition(self, r):
@@ -813,7 +831,6 @@ class RecycledGCR:
                 if its >= max_its or not np.isfinite(res):
                     return None, None, 0, its, []
                 r = rt - (Q[:k] @ rt) @ Q[:k]  # continue from the true residual
-            t0 = time.perf_counter()
             z = self._precondition(r)
             cz = C @ z  # the one dense (or hierarchical) product
             q = D @ z + G @ cz
@@ -835,7 +852,6 @@ class RecycledGCR:
             r -= g[k] * Q[k]
             k += 1
             hist.append(float(np.linalg.norm(r)) / bnorm)
-            self.t_iter = time.perf_counter() - t0
 
     def _tracked_ok(self, C, x, Cx, ages) -> bool:
         """Is the tracked ``C x`` within ``_TRACK_RTOL`` of the true one?

@@ -537,6 +537,9 @@ def test_predicted_wall_follows_the_fitted_cost():
     assert predicted_wall([a, cheap], 16000, 0.5) == pytest.approx(cheap.info["wall"] * 4.0**lo * 2.0)
     dear = _Run(1.0, 4000, 200, 200 * 1e-3 * 4.0**3)  # cells^3: clipped down
     assert predicted_wall([a, dear], 16000, 0.5) == pytest.approx(dear.info["wall"] * 4.0**hi * 2.0)
+    # a run's estimate (its companions) counts with it: 30 % more, the same exponent
+    a.info["estimate_wall"], b.info["estimate_wall"] = 0.3 * a.info["wall"], 0.3 * b.info["wall"]
+    assert predicted_wall([a, b], 16000, 0.5) == pytest.approx(1.3 * b.info["wall"] * 4.0**1.6 * 2.0)
 
 
 def test_max_wall_is_checked():

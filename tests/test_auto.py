@@ -314,9 +314,10 @@ def test_the_companions_estimate_is_exact_on_its_error_model():
 
 def test_the_next_run_aims_space_and_time_at_their_shares():
     """From a run's space and time parts: the level for (1 - TIME_SHARE) SAFETY tol at order 2,
-    at most ``hi`` finer, never coarser; the time tolerance in proportion for TIME_SHARE SAFETY
-    tol, within TAU_STEP (never loosened); no estimate: ``hi`` times finer in both."""
-    from femehl.accuracy.auto import RATIO_MAX, SAFETY, TAU_STEP, TIME_SHARE, _next_run
+    RATIO_MIN to RATIO_MAX finer when short in space, else the same; the time tolerance in
+    proportion for TIME_SHARE SAFETY tol, within TAU_STEP (never loosened); no estimate:
+    RATIO_MAX times finer in both."""
+    from femehl.accuracy.auto import RATIO_MAX, RATIO_MIN, SAFETY, TAU_STEP, TIME_SHARE, _next_run
 
     def est(space, slow):
         z = np.zeros(2)
@@ -330,6 +331,9 @@ def test_the_next_run_aims_space_and_time_at_their_shares():
     assert level == pytest.approx(1 / RATIO_MAX) and tol_t == pytest.approx(1e-3 * TAU_STEP[0])
     level, tol_t = _next_run(1.0, 1e-3, est(1e-3 * aim, 0.0), tol)
     assert level == 1.0 and tol_t == pytest.approx(1e-3) and TAU_STEP[1] == 1.0
+    # short in space by 1.05**2: RATIO_MIN finer, not 1.05 (a step within the estimate's noise)
+    level, _ = _next_run(1.0, 1e-3, est(1.05**2 * (1 - TIME_SHARE) * aim, 0.0), tol)
+    assert level == pytest.approx(1 / RATIO_MIN) and RATIO_MIN == 1.2
     unknown = _next_run(1.0, 1e-3, None, tol)
     assert unknown == (pytest.approx(1 / RATIO_MAX), pytest.approx(1e-3 / RATIO_MAX**2))
 

@@ -110,6 +110,13 @@ ACCEPT = 1.0
 #: most 2 here made the next run, 4 times the cells, fall short of tol on 12 of the 13
 #: benchmark scenes, and a third run followed (2026-12-05, benchmarks/auto_results.md)
 RATIO_MAX = 2.0 * math.sqrt(2.0)
+#: a run finer in space is at least this much finer than the last: the space estimate of
+#: meshes adapted to one run moves by 10-20 % between nearby levels (the sphere's sliding
+#: at beta = 20: 0.75 % at level 0.966, 0.85 % at 0.892, a step of 1.08 that was to bring
+#: 0.64 %; the paper case: 0.83-0.98 % on meshes a few cells apart), so a smaller step is
+#: a coin flip that costs a run.  Only steps the estimate asks for in space: a run short in
+#: time alone keeps its level
+RATIO_MIN = 1.2
 #: the level the estimate asks for would exceed the cell budget: the finest level within
 #: it is still run if it is at least this ratio finer than the last run (its error about
 #: 1 / ratio**2 <= 0.69 of the last one's: less is not worth a run that costs more), found
@@ -575,7 +582,8 @@ def _fitted_to(ladder: Ladder, t_fit: float) -> Ladder:
 
 def _next_run(level: float, tol_t: float, est: Estimate | None, tol: float) -> tuple:
     """The next run's level and time tolerance: its space error aimed at ``(1 - TIME_SHARE)
-    * SAFETY * tol`` (order 2 in the level, at most :data:`RATIO_MAX` times finer, never coarser),
+    * SAFETY * tol`` (order 2 in the level; finer by :data:`RATIO_MIN` to :data:`RATIO_MAX`
+    when it is short in space, else the same level),
     its time error at ``TIME_SHARE * SAFETY * tol`` (about proportional to ``tol_t``,
     changed by a factor within :data:`TAU_STEP`)."""
     if est is None:  # no estimate (the companions stopped): RATIO_MAX times finer in both
@@ -583,7 +591,7 @@ def _next_run(level: float, tol_t: float, est: Estimate | None, tol: float) -> t
     aim = SAFETY * tol
     space, slow = est.worst("space"), est.worst("time")
     ratio = math.sqrt(space / ((1.0 - TIME_SHARE) * aim)) if space > 0 else 1.0
-    ratio = min(RATIO_MAX, max(1.0, ratio))
+    ratio = 1.0 if ratio <= 1.0 else min(RATIO_MAX, max(RATIO_MIN, ratio))
     factor = TIME_SHARE * aim / slow if slow > 0 else TAU_STEP[1]
     factor = min(TAU_STEP[1], max(TAU_STEP[0], factor))
     return level / ratio, min(TAU_RANGE[1], max(TAU_RANGE[0], tol_t * factor))

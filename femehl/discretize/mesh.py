@@ -19,7 +19,7 @@ import math
 import os
 import pathlib
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import skfem
@@ -448,21 +448,16 @@ class LinearSizes:
     triangles: np.ndarray
     values: np.ndarray
     far: float
+    _interpolator: object = field(default=None, init=False, repr=False)  # built on the first call
 
     def __call__(self, x: float, y: float) -> float:
-        p, t = self.nodes, self.triangles
-        x0, y0 = p[0, t[0]], p[1, t[0]]
-        ax, ay = p[0, t[1]] - x0, p[1, t[1]] - y0
-        bx, by = p[0, t[2]] - x0, p[1, t[2]] - y0
-        det = ax * by - ay * bx
-        u = ((x - x0) * by - (y - y0) * bx) / det
-        v = (ax * (y - y0) - ay * (x - x0)) / det
-        inside = np.flatnonzero((u >= -1e-12) & (v >= -1e-12) & (u + v <= 1.0 + 1e-12))
-        if inside.size == 0:
-            return float(self.far)
-        k = inside[0]
-        h = self.values[t[:, k]]
-        return float(h[0] + u[k] * (h[1] - h[0]) + v[k] * (h[2] - h[0]))
+        if self._interpolator is None:
+            import matplotlib.tri as mtri
+
+            tri = mtri.Triangulation(self.nodes[0], self.nodes[1], self.triangles.T)
+            object.__setattr__(self, "_interpolator", mtri.LinearTriInterpolator(tri, self.values))
+        v = self._interpolator(x, y)
+        return float(self.far) if np.ma.is_masked(v) else float(v)
 
     def gmsh_list(self) -> np.ndarray:
         """gmsh's list data of scalar triangles ("ST"): per triangle x1..3, y1..3, z1..3, v1..3."""
@@ -551,9 +546,9 @@ def _gmsh_disk(L, half, h):
             views.append(view)
             data = h.gmsh_list()
             gmsh.view.addListData(view, "ST", data.shape[0], data.ravel().tolist())
-            field = gmsh.model.mesh.field.add("PostView")
-            gmsh.model.mesh.field.setNumber(field, "ViewTag", view)
-            gmsh.model.mesh.field.setAsBackgroundMesh(field)
+            background = gmsh.model.mesh.field.add("PostView")
+            gmsh.model.mesh.field.setNumber(background, "ViewTag", view)
+            gmsh.model.mesh.field.setAsBackgroundMesh(background)
             gmsh.option.setNumber("Mesh.MeshSizeMax", float(h.far))
         else:
             gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, lc: h(x, y))

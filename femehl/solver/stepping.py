@@ -133,11 +133,21 @@ class _Planned:
     retried), an accepted one is yielded and ``_accepted`` moves the plan on."""
 
     def judge(self, trial: State | None, failure: Exception | None):
+        if failure is None:
+            try:
+                _check_film(trial)
+            except FilmRuptureError as exc:
+                failure = exc
         if failure is not None:
+            if self._retry(failure):
+                return
             raise failure
-        _check_film(trial)
         self._accepted(trial)
         yield trial
+
+    def _retry(self, failure: Exception) -> bool:
+        """Plan the failed step again (True) or let ``failure`` stand (False: the default)."""
+        return False
 
 
 class FixedSteps(_Planned):
@@ -218,22 +228,15 @@ class GivenSteps(_Planned):
             base = without_history(base)
         return base, t_new, t_new - base.t
 
-    def judge(self, trial: State | None, failure: Exception | None):
-        if failure is None:
-            try:
-                _check_film(trial)
-            except FilmRuptureError as exc:
-                failure = exc
+    def _retry(self, failure: Exception) -> bool:
+        """The failed step cut in two, while it has been cut fewer than ``halvings`` times."""
         depth = self._depth[0]
-        if failure is not None:
-            if depth >= self.halvings:
-                raise failure
-            self._stops.insert(0, 0.5 * (self._last.t + self._stops[0]))
-            self._depth[:1] = [depth + 1, depth + 1]
-            self.cut += 1
-            return
-        self._accepted(trial)
-        yield trial
+        if depth >= self.halvings:
+            return False
+        self._stops.insert(0, 0.5 * (self._last.t + self._stops[0]))
+        self._depth[:1] = [depth + 1, depth + 1]
+        self.cut += 1
+        return True
 
     def _accepted(self, trial: State) -> None:
         self._stops.pop(0)

@@ -228,8 +228,9 @@ def test_the_fast_operator_runs_a_free_indenters_first_steps():
     fast, dense = runs["fast"], runs["dense"]
     assert fast.info.get("recycle_resets", 0) >= 1  # the case of the fault
     assert fast.nsteps == dense.nsteps
-    for q in ("film_min", "hc"):
-        np.testing.assert_allclose(getattr(fast, q), getattr(dense, q), rtol=1e-5)
-    # the load grows from 0: against its largest (measured 4e-5; the operator's 1e-6
-    # magnified by the squeeze's 1/dt at the first steps)
-    np.testing.assert_allclose(fast.load, dense.load, rtol=0, atol=2e-4 * np.max(np.abs(dense.load)))
+    # measured: films 7e-8, hc 2e-6, the load 3.2e-5 of its largest (it grows from 0, and
+    # the fast operator's 1e-6 deflection error is magnified by the squeeze's 1/dt at the
+    # first steps); bounds about three times those
+    np.testing.assert_allclose(fast.film_min, dense.film_min, rtol=3e-7)
+    np.testing.assert_allclose(fast.hc, dense.hc, rtol=6e-6)
+    np.testing.assert_allclose(fast.load, dense.load, rtol=0, atol=1e-4 * np.max(np.abs(dense.load)))

@@ -479,7 +479,7 @@ def _write_si_summary(dim, result, out):
     cols = list(table)
     with open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow([f"{c}_{dim.RESULT_COLUMNS[c][2]}" for c in cols])
+        w.writerow([f"{c}_{dim.unit(c)}" for c in cols])
         for i in range(len(table["t"])):
             w.writerow([f"{table[c][i]:.10g}" for c in cols])
     os.replace(tmp, path)

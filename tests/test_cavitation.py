@@ -22,6 +22,7 @@ import femehl
 from femehl.errors import SceneError
 from femehl.problem.line import LineScene
 from femehl.problem.scene import Constant, Fluid, Motion
+from femehl.solver.energetics import FRICTION_COLUMNS
 
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
@@ -300,9 +301,9 @@ def test_summary_columns_series_and_restart(tmp_path):
             assert np.allclose(a[c], getattr(whole, c), rtol=1e-9, atol=1e-12)
         vtu = sorted((tmp_path / f"{cav}-a").glob("fields_*.vtu"))[-1]
         assert field_value(vtu, "HalfSommerfeldClipped") == (1.0 if cav == "half-sommerfeld" else None)
-    assert cols[None] == COLUMNS
-    assert cols["reynolds"] == COLUMNS + ("cavitated_area", "full_film_source")
-    assert cols["half-sommerfeld"] == COLUMNS + ("load_full", "cavitated_area")
+    assert cols[None] == COLUMNS + FRICTION_COLUMNS
+    assert cols["reynolds"] == COLUMNS + ("cavitated_area", "full_film_source") + FRICTION_COLUMNS
+    assert cols["half-sommerfeld"] == COLUMNS + ("load_full", "cavitated_area") + FRICTION_COLUMNS
     text = sorted((tmp_path / "half-sommerfeld-a").glob("fields_*.vtu"))[-1].read_text(errors="ignore")
     assert "half-Sommerfeld: negative pressures clipped after the solve" in text
 

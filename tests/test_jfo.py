@@ -30,6 +30,7 @@ import femehl
 from femehl.errors import SceneError
 from femehl.problem.line import LineScene
 from femehl.problem.scene import Constant, Fluid, Motion, RampHold
+from femehl.solver.energetics import FRICTION_COLUMNS
 
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
@@ -192,7 +193,7 @@ def test_resume_series_and_columns(tmp_path):
     assert np.array_equal(resumed.final.own["gas"], whole.final.own["gas"])
     a, b = (read_summary(tmp_path / s / "summary.csv") for s in "ab")
     extra = tuple(c for c in a if not c.startswith("err_"))[len(COLUMNS) :]
-    assert extra == femehl.problem.cavitation.JFOCavitation.columns
+    assert extra == femehl.problem.cavitation.JFOCavitation.columns + FRICTION_COLUMNS
     for c in extra:
         assert np.array_equal(a[c], b[c]), c
     import meshio

@@ -15,6 +15,7 @@ from femehl.output.table import COLUMNS, ERROR_COLUMNS
 from femehl.problem.line import LineScene
 from femehl.problem.scene import Motion, RampHold, TanhStart
 from femehl.problem.scenefile import load_scene_file
+from femehl.solver.energetics import FRICTION_COLUMNS
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 TOML = ROOT / "examples" / "cylinder_winkler.toml"
@@ -44,7 +45,7 @@ def test_cli_runs_line_contact(tmp_path, capsys):
     with open(out / "summary.csv", newline="") as fh:
         rows = list(csv.reader(fh))
     # the expert run's space estimate (a companion on 200 elements) is appended at the end
-    assert tuple(rows[0]) == COLUMNS + ERROR_COLUMNS
+    assert tuple(rows[0]) == COLUMNS + FRICTION_COLUMNS + ERROR_COLUMNS
     assert all(r[len(COLUMNS) + 1] for r in rows[1:])  # err_load_space is filled
     data = np.array([r[: len(COLUMNS)] for r in rows[1:]], dtype=float)
     ref = solve_line(load_scene_file(TOML)[0], 2.0, 0.05, n_elements=400)

@@ -329,7 +329,20 @@ def test_interrupt_leaves_readable_output_and_resumes(tmp_path, monkeypatch):
     run_to_folder(SC, full, t_end=0.1, mesh="coarse", dt=0.02, store_every=2)
     a, b = _rows(out), _rows(full)
     assert [r[0] for r in a] == [r[0] for r in b]
-    np.testing.assert_allclose(np.array(a[1:], float), np.array(b[1:], float), rtol=1e-6, atol=1e-12)
+    _same_rows(a, b)
+
+
+def _same_rows(a, b):
+    """The rows of two summaries agree to 1e-6; the friction columns, sums of terms of both
+    signs that cancel to ~1e-4 of the load during a pure indentation (no sliding: 3e-6
+    here), to 1e-6 of the largest load (their rounding measured 5e-11 apart)."""
+    from femehl.solver.energetics import FRICTION_COLUMNS
+
+    x, y = np.array(a[1:], float), np.array(b[1:], float)
+    fric = np.isin(a[0], FRICTION_COLUMNS)
+    np.testing.assert_allclose(x[:, ~fric], y[:, ~fric], rtol=1e-6, atol=1e-12)
+    scale = 1e-6 * np.max(np.abs(y[:, a[0].index("load")]))
+    np.testing.assert_allclose(x[:, fric], y[:, fric], rtol=0.0, atol=scale)
 
 
 # ---- folder states x actions -----------------------------------------------------------------

@@ -518,7 +518,7 @@ def test_scene_file_new_indenters_and_load(tmp_path):
             r"\[motion.load\].*finite \(no NaN",
         ),
         ("[motion]\nload = nan\n", r"\[motion.load\].*finite"),
-        ("[motion]\nspeed = 1.0\n", r"\[motion\] takes gap, velocity, load"),
+        ("[motion]\nspeed = 1.0\n", r"\[motion\] takes gap, velocity, slide_roll, load"),
         ("[motion]\nforce = 1.0\n", r"force and hc_dot0 belong to a free indenter: give mass"),
         (
             "[si]\nR = 0.01\nG = 1e5\neta = 1.0\nV_ss = 0.01\nh_inf = 1e-4\nh0 = 1e-5\n"
@@ -571,6 +571,11 @@ def test_result_table_in_si():
         "p_max",
         "p_max_x",
         "p_max_y",
+        "friction",
+        "shear_couette",
+        "shear_poiseuille",
+        "pressure_drag",
+        "friction_coefficient",
     }
     assert np.allclose(tab["t"], res.t * DIM.time)
     assert np.allclose(tab["hc"], res.hc * 1e-4) and tab["hc"][0] == pytest.approx(1e-5)

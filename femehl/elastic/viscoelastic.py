@@ -3,7 +3,8 @@
 :class:`Viscoelastic` (unrelaxed and relaxed shear moduli ``G0``, ``G_inf`` in units of the
 scene's G, stress-relaxation time ``tau``) relaxes any elastic substrate by the
 correspondence principle: ``w = -(J0 C p + q)``, the creep ``q`` an internal variable that
-:class:`CreepMemory` carries with the material (``D/Dt = d/dt - 2 V d/dx``) by an exact
+:class:`CreepMemory` carries with the material (``D/Dt = d/dt - 2 U d/dx``, ``U`` the
+substrate surface's speed, :meth:`femehl.Motion.substrate_speed`) by an exact
 exponential integrator on a uniform grid, so that each step is still one linear system.
 The constitutive law, the scheme, its step limit and the limits: docs/design.md section 15.
 """
@@ -133,14 +134,15 @@ class Viscoelastic:
     TRANSIT_STEPS = 4
 
     def step_limit(self, scene, disc, t_end: float) -> float:
-        """The largest step the memory's integrator resolves: the sliding material crosses
+        """The largest step the memory's integrator resolves: the moving material crosses
         the film domain (its extent along x) in at least :attr:`TRANSIT_STEPS` steps at the
-        largest speed of the run, ``span / (2 V_max TRANSIT_STEPS)``; math.inf without sliding.
+        largest speed of the run, ``span / (2 U_max TRANSIT_STEPS)`` (``U`` the substrate's
+        surface speed); math.inf while the substrate's surface is still.
 
         Each step integrates the memory exactly along the characteristic for a source frozen
         in time and takes the source's increment over the step at the arrival point: exact
         in a steady state whatever dt, second order in a transient while the step's shift
-        ``2 V dt`` is a fraction of the length over which the source varies (the contact).
+        ``2 U dt`` is a fraction of the length over which the source varies (the contact).
         Beyond that the memory of the whole domain is rebuilt each step from the previous
         step's source, an error the adaptive steps' film-based estimate does not scale with;
         a quarter of the domain keeps it a fraction of the contact for L >= 2 a.
@@ -151,7 +153,7 @@ class Viscoelastic:
         if motion is None or span <= 0.0:
             return math.inf
         ts = np.union1d(np.linspace(0.0, float(t_end), 2001), getattr(motion, "breakpoints", ()) or ())
-        v = max(abs(float(motion.V(t))) for t in ts[(ts >= 0.0) & (ts <= t_end)])
+        v = max(abs(float(motion.substrate_speed(t))) for t in ts[(ts >= 0.0) & (ts <= t_end)])
         return math.inf if v == 0.0 else span / (2.0 * v * self.TRANSIT_STEPS)
 
     def memory(self, disc) -> CreepMemory:
@@ -217,10 +219,10 @@ class CreepMemory:
     kept so that a step of any size continues the film points' memory without a jump).
 
     Step (exact along the characteristic, for any dt).  The material at ``x`` at
-    ``t_{k+1}`` was at ``x + sigma(theta)`` a time ``theta`` earlier, ``sigma = 2 int V``
-    (V linear over the step).  With the source linear in time between ``u^k`` (on the
-    path) and ``u^{k+1}`` (its increment taken at the arrival point ``x``: an
-    ``O(dt^2 V du/dx)`` error, second order, zero in a steady state)::
+    ``t_{k+1}`` was at ``x + sigma(theta)`` a time ``theta`` earlier, ``sigma = 2 int U``
+    (the substrate's surface speed U linear over the step).  With the source linear in time
+    between ``u^k`` (on the path) and ``u^{k+1}`` (its increment taken at the arrival point ``x``: an
+    ``O(dt^2 U du/dx)`` error, second order, zero in a steady state)::
 
         q^{k+1}(x) = e^{-r} q^k(x + s) + (dJ/tau_c) int_0^dt e^{-theta/tau_c} u^k(x + sigma) dtheta
                      + w [u^{k+1}(x) - u^k(x)],       r = dt/tau_c,  s = sigma(dt),
@@ -388,7 +390,7 @@ class CreepMemory:
         return system, rhs_list, None
 
     def film(self, stepper, state, t_new: float, dt: float) -> StepMemory:
-        return self.step(state, t_new, dt, stepper.scene.motion.V)
+        return self.step(state, t_new, dt, stepper.scene.motion.substrate_speed)
 
     def finish(self, stepper, solved, new):
         """The internal variable after the step, from the step's ``u = C p``."""
@@ -396,7 +398,9 @@ class CreepMemory:
 
     # ---- one step -----------------------------------------------------------------------
     def step(self, state, t_new: float, dt: float, V) -> StepMemory:
-        """The step's scale and offset from the material's history (``state.own["creep"]``).
+        """The step's scale and offset from the material's history (``state.own["creep"]``);
+        ``V(t)`` is the substrate's surface speed (:meth:`femehl.Motion.substrate_speed`, the
+        material moving at ``-2 V``).
 
         Exact along the characteristic whatever the step (class docstring).
         """

@@ -67,7 +67,7 @@ class RunWriter:
         self.folder = pathlib.Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         if summary is None:
-            columns = columns_for(getattr(disc, "scene", None))
+            columns = columns_for(getattr(disc, "scene", None), disc)
             summary = SummaryWriter(self.folder / "summary.csv", columns=columns)
         self.summary = summary
         if series is None and every:

@@ -435,7 +435,7 @@ def resume_writer(folder, disc, every: int, t_ckpt: float):
     _cut_summary(summary, t_ckpt)
     from femehl.output.table import columns_for
 
-    columns = columns_for(getattr(disc, "scene", None))
+    columns = columns_for(getattr(disc, "scene", None), disc)
     _align_summary(summary, columns)
     series = None
     if every:

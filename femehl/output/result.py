@@ -62,7 +62,7 @@ class Result:
         from femehl.problem.cavitation import cavitation_columns
 
         self._cavitation_columns = cavitation_columns(self.scene)
-        self._extra_columns = extra_columns(self.scene)
+        self._extra_columns = extra_columns(self.scene, self.disc)
         for k in self._extra_columns:
             self._rows.setdefault(k, [])
 
@@ -76,8 +76,10 @@ class Result:
     @property
     def extra_columns(self) -> tuple:
         """Every per-step figure beyond the standard ones, as in ``summary.csv``: the
-        cavitation condition's and the substrate's (a viscoelastic solid's ``friction``,
-        ``dissipation_film``, ``power_sliding``, :mod:`femehl.solver.energetics`)."""
+        cavitation condition's, the friction force and its parts (``friction``,
+        ``shear_couette``, ``shear_poiseuille``, ``pressure_drag``; finite elements), the
+        substrate's (a viscoelastic solid's ``dissipation_film``, ``power_sliding``) and a
+        free indenter's (:mod:`femehl.solver.energetics`)."""
         return self._extra_columns
 
     def record(self, state: State, store_fields: bool = True) -> None:

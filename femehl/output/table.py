@@ -27,23 +27,28 @@ COLUMNS = (
 )
 
 
-def columns_for(scene) -> tuple:
-    """The summary columns of a run of ``scene``: :data:`COLUMNS` and its cavitation
-    condition's (``scene.cavitation``; none for full Sommerfeld)."""
+def columns_for(scene, disc=None) -> tuple:
+    """The summary columns of a run of ``scene`` on ``disc``: :data:`COLUMNS` and
+    :func:`extra_columns`."""
 
-    return COLUMNS + extra_columns(scene)
+    return COLUMNS + extra_columns(scene, disc)
 
 
-def extra_columns(scene) -> tuple:
-    """The per-step figures beyond :data:`COLUMNS` a run of ``scene`` reports: its cavitation
-    condition's, then its substrate's (``substrate.columns``, e.g. a viscoelastic solid's
-    sliding energy budget, :mod:`femehl.solver.energetics`); read from ``state.info``."""
+def extra_columns(scene, disc=None) -> tuple:
+    """The per-step figures beyond :data:`COLUMNS` a run of ``scene`` on ``disc`` reports:
+    its cavitation condition's, the friction force and its parts where ``disc`` has
+    pressure gradients (:data:`femehl.solver.energetics.FRICTION_COLUMNS`), then its
+    substrate's (``substrate.columns``, e.g. a viscoelastic solid's sliding energy budget)
+    and a free indenter's; read from ``state.info``."""
     from femehl.problem.cavitation import cavitation_columns
-    from femehl.solver.energetics import FREE_COLUMNS
+    from femehl.solver.energetics import FREE_COLUMNS, FRICTION_COLUMNS
 
     if scene is None:
         return ()
-    cols = cavitation_columns(scene) + tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
+    cols = cavitation_columns(scene)
+    if hasattr(disc, "pressure_gradient"):
+        cols += FRICTION_COLUMNS
+    cols += tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
     if getattr(getattr(scene, "motion", None), "free", False):  # a free indenter's energy budget
         cols += FREE_COLUMNS
     return tuple(dict.fromkeys(cols))

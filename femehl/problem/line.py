@@ -130,7 +130,7 @@ class LineDomain:
                 "is not modelled in 1-D."
             )
         motion = scene.motion
-        motion.V(0.0)
+        motion.surface_speeds(0.0)
         if motion.load_controlled:
             times = np.union1d(np.linspace(0.0, 10.0, 201), getattr(motion.load, "times", ()))
             for t in times[times >= 0.0]:
@@ -217,7 +217,8 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
     beta : float, default: 10.0
         The paper's film parameter multiplying ``d/dx(d^3 dp/dx)`` (> 0).
     motion : femehl.Motion, default: ramp 0.1 -> -0.5 for t <= 1, then tanh(t - 1) sliding
-        Tip clearance hc(t) and sliding velocity V(t) (cylinder moves toward +x).
+        Tip clearance hc(t), velocity V(t) and slide-to-roll ratio (the film entrained toward
+        -x; by default the cylinder slides toward +x, its surface still).
         With an imposed load, ``motion.gap`` only gives the initial clearance hc(0).
     L : float, default: 2.0
         Half length of the domain ``[-L, L]``; p = 0 at both ends.
@@ -242,7 +243,7 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
             raise SceneError("the load is imposed twice (LineScene.load and Motion.load): give only one.")
         load = _as_time_function("LineScene load F(t)", load)
         check_finite("load F(t=0)", load(0.0), "The load history must return finite values.")
-        motion = Motion(gap=motion.gap, velocity=motion.velocity, load=load)
+        motion = dataclasses.replace(motion, load=load)
     k = check_positive("Winkler stiffness k", k, "Use a large k for a nearly rigid substrate.")
     beta = check_positive("beta", beta, "beta multiplies d/dx(d^3 dp/dx) in the normalized equation.")
     substrate = Winkler(k)

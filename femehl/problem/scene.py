@@ -260,14 +260,25 @@ class Fluid:
 
 @dataclass(frozen=True)
 class Motion:
-    """Tip clearance ``hc(t)`` and sliding velocity ``V(t)`` (indenter moves toward +x).
+    """Tip clearance ``hc(t)``, surface velocities ``V(t)`` and ``slide_roll(t)`` (the film
+    is entrained toward -x: in the paper the indenter slides toward +x).
 
     Parameters
     ----------
     gap : callable or float, default: RampHold()
         Tip clearance hc(t); hc > 0 is a gap, hc < 0 an indentation.
     velocity : callable or float, default: 0.0
-        Sliding velocity V(t) in units of V_ss.
+        V(t): the sum of the two surfaces' speeds along -x in the contact's frame, in units
+        of V_ss (twice the entrainment speed; the paper's sliding velocity, whose indenter
+        surface is still).  The Reynolds equation's transport is ``V dd/dx``.
+    slide_roll : callable or float, default: 2.0
+        The slide-to-roll ratio SRR(t) = (u_substrate - u_indenter) / u_entrainment of the
+        surfaces' speeds along -x: 2 is pure sliding of the substrate under an indenter
+        whose surface is still (the paper), 0 pure rolling, -2 the indenter's surface
+        sliding over a still substrate.  The substrate's surface moves at
+        ``V (1 + SRR/2) / 2``, the indenter's at ``V (1 - SRR/2) / 2`` (units of V_ss): the
+        first carries a viscoelastic substrate's memory, their difference ``V SRR / 2``
+        shears the film (:meth:`surface_speeds`).
     load : callable or float, optional
         Imposed load F(t) = int p dA, >= 0 (the film cannot pull: a negative
         load at t = 0 or any sampled time is refused).  Then hc(t) is solved for at every step
@@ -287,6 +298,7 @@ class Motion:
     gap: Callable[[float], float] = field(default_factory=RampHold)
     velocity: Callable[[float], float] = field(default_factory=Constant)
     load: Callable[[float], float] | None = None
+    slide_roll: Callable[[float], float] = field(default=Constant(2.0), metadata={"describe": "omit_default"})
     mass: float | None = field(default=None, metadata={"describe": "omit_default"})
     force: Callable[[float], float] | None = field(default=None, metadata={"describe": "omit_default"})
     hc_dot0: float = field(default=0.0, metadata={"describe": "omit_default"})
@@ -294,6 +306,9 @@ class Motion:
     def __post_init__(self):
         object.__setattr__(self, "gap", _as_time_function("Motion gap hc(t)", self.gap))
         object.__setattr__(self, "velocity", _as_time_function("Motion velocity V(t)", self.velocity))
+        object.__setattr__(
+            self, "slide_roll", _as_time_function("Motion slide-to-roll ratio SRR(t)", self.slide_roll)
+        )
         if self.load is not None:
             object.__setattr__(self, "load", _as_time_function("Motion load F(t)", self.load))
         if self.mass is None:
@@ -348,6 +363,7 @@ class Motion:
         Adaptive time stepping (:mod:`femehl.solver.adaptive`) lands on these times."""
         funcs = [
             self.velocity,
+            self.slide_roll,
             self.load if self.load_controlled else (self.force if self.free else self.gap),
         ]
         times = set()
@@ -380,6 +396,28 @@ class Motion:
             "The velocity history must return finite values.",
         )
 
+    def SRR(self, t: float) -> float:
+        """The slide-to-roll ratio at ``t`` (finite)."""
+        return call_time_function(
+            "the slide-to-roll ratio SRR(t)",
+            "SRR",
+            self.slide_roll,
+            t,
+            "The slide-to-roll ratio must return finite values (2: pure sliding, 0: pure rolling).",
+        )
+
+    def surface_speeds(self, t: float) -> tuple:
+        """``(u_indenter, u_substrate)``: the two surfaces' speeds along -x at ``t`` in units
+        of V_ss, ``V (1 -+ SRR/2) / 2``; their mean is the entrainment ``V/2``."""
+        V, srr = self.V(t), self.SRR(t)
+        return 0.5 * V * (1.0 - 0.5 * srr), 0.5 * V * (1.0 + 0.5 * srr)
+
+    def substrate_speed(self, t: float) -> float:
+        """The substrate's surface speed along -x at ``t`` (units of V_ss): its material, and
+        a viscoelastic substrate's memory, moves at ``-2 substrate_speed`` in normalized
+        lengths per normalized time (docs/design.md section 15)."""
+        return self.surface_speeds(t)[1]
+
 
 def _negative_load_message(F: float, t: float) -> str:
     return (
@@ -407,7 +445,7 @@ class Domain:
     def check(self, scene) -> None:
         """SceneError unless the disk holds ``scene``'s run (film open at t = 0, contact inside)."""
         hc0 = scene.motion.hc(0.0)
-        scene.motion.V(0.0)  # a velocity history that fails at t = 0 is refused now
+        scene.motion.surface_speeds(0.0)  # a velocity or SRR history that fails at t = 0 is refused now
         if hc0 <= 0.0:
             raise SceneError(
                 f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
@@ -846,12 +884,23 @@ class Dimensional:
         "load_full": ("load_full", "force", "N"),
         "cavitated_area": ("cavitated_area", "area", "m2"),
         "full_film_source": ("full_film_source", "volume_rate", "m3/s"),
-        # a viscoelastic substrate's sliding energy budget (femehl.solver.energetics)
+        # the friction force and its parts (finite elements), a viscoelastic substrate's
+        # energy budget, a free indenter's (femehl.solver.energetics)
         "friction": ("friction", "tangential_force", "N"),
+        "shear_couette": ("shear_couette", "tangential_force", "N"),
+        "shear_poiseuille": ("shear_poiseuille", "tangential_force", "N"),
+        "pressure_drag": ("pressure_drag", "tangential_force", "N"),
         "dissipation_film": ("dissipation_film", "power", "W"),
         "power_sliding": ("power_sliding", "power", "W"),
         "elastic_energy": ("elastic_energy", "energy", "J"),
     }
+
+    #: columns :meth:`result_table` derives from the others -> SI unit
+    DERIVED_COLUMNS: ClassVar[dict] = {"friction_coefficient": "1"}
+
+    def unit(self, column: str) -> str:
+        """The SI unit of a column of :meth:`result_table`."""
+        return {**{k: v[2] for k, v in self.RESULT_COLUMNS.items()}, **self.DERIVED_COLUMNS}[column]
 
     def result_table(self, result) -> dict:
         """The per-step table of a normalized ``result`` in SI units.
@@ -867,15 +916,23 @@ class Dimensional:
             ``t`` [s], ``hc`` [m], ``load`` [N], ``film_center`` [m], ``film_min`` [m],
             ``film_min_x``, ``film_min_y`` [m], ``p_max`` [Pa], ``p_max_x``,
             ``p_max_y`` [m], and a cavitation condition's ``load_full`` [N],
-            ``cavitated_area`` [m^2], ``full_film_source`` [m^3/s] where the result has
-            them; the units are in :attr:`RESULT_COLUMNS`.
+            ``cavitated_area`` [m^2], ``full_film_source`` [m^3/s], the friction force and
+            its parts [N] where the result has them (the units are in
+            :attr:`RESULT_COLUMNS`), and with the friction the friction coefficient
+            ``friction_coefficient = friction / load`` (NaN while the load is 0).
         """
         s = result.summary()
-        return {
+        out = {
             name: np.asarray(self.to_si(scale, s[col]), dtype=float)
             for name, (col, scale, _unit) in self.RESULT_COLUMNS.items()
             if col in s
         }
+        if "friction" in out:  # the friction coefficient, undefined (NaN) where nothing is carried
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out["friction_coefficient"] = np.where(
+                    out["load"] > 0.0, out["friction"] / out["load"], np.nan
+                )
+        return out
 
     def scene(self, h0: float, t1: float | None = None, T: float | None = None, L: float = 2.0) -> Scene:
         """The paper's ramp-hold-slide experiment for these SI values.

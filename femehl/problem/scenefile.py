@@ -254,7 +254,7 @@ def _si_scene(raw, path):
     si = dict(si)
     visco = {"G0", "tau", "G_inf"}  # a standard linear solid: unrelaxed modulus, relaxation time
     free = {"mass", "force", "hc_dot0", "sliding"}  # a free indenter: kg, N, m/s; sliding on/off
-    free |= {"cavitation"}  # the fluid's cavitation condition (as [fluid] cavitation)
+    free |= {"cavitation", "slide_roll"}  # [fluid] cavitation; the slide-to-roll ratio (2: sliding)
     optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco | free
     keys = {"R", "G", "eta", "V_ss", "h_inf", "h0"} | optional
     extra = set(si) - keys
@@ -286,8 +286,8 @@ def _si_scene(raw, path):
             changes["substrate"] = Layer(h / dim.length, nu=dim.nu)
         if "load" in si:
             F = check_finite("[si] load [N]", si["load"]) / dim.force
-            changes["motion"] = Motion(
-                gap=Constant(scene.motion.hc(0.0)), velocity=scene.motion.velocity, load=Constant(F)
+            changes["motion"] = dataclasses.replace(
+                scene.motion, gap=Constant(scene.motion.hc(0.0)), load=Constant(F)
             )
         if "alpha" in si or "roelands_Z" in si:  # pressure-viscosity: Barus [1/Pa], or Roelands
             from femehl.problem.viscosity import Barus, Roelands
@@ -304,16 +304,16 @@ def _si_scene(raw, path):
             changes["fluid"] = dataclasses.replace(scene.fluid, viscosity=model)
         if "sliding" in si and not isinstance(si["sliding"], bool):
             raise SceneFileError(f"{path}: [si] sliding must be true or false, got {si['sliding']!r}.")
-        if free & set(si) - {"sliding", "cavitation"}:  # a free indenter (Newton's law), in SI
+        if free & set(si) - {"sliding", "cavitation", "slide_roll"}:  # a free indenter (Newton's law), in SI
             if "mass" not in si or "load" in si:
                 raise SceneFileError(
                     f"{path}: [si] a free indenter needs mass [kg] (with optional force [N] and "
                     "hc_dot0 [m/s], the initial dhc/dt, < 0 toward the substrate), and no load."
                 )
             m = check_positive("[si] mass [kg]", si["mass"], "Give the indenter's mass in kg.")
-            changes["motion"] = Motion(
+            changes["motion"] = dataclasses.replace(
+                scene.motion,
                 gap=Constant(check_positive("[si] h0 [m]", si["h0"]) / dim.height),
-                velocity=scene.motion.velocity,
                 mass=m / dim.mass,
                 force=check_finite("[si] force [N]", si.get("force", 0.0)) / dim.force,
                 hc_dot0=check_finite("[si] hc_dot0 [m/s]", si.get("hc_dot0", 0.0)) / dim.approach_speed,
@@ -324,6 +324,10 @@ def _si_scene(raw, path):
         if si.get("sliding", True) is False:  # no sliding: the indenter only approaches
             mo = changes.get("motion", scene.motion)
             changes["motion"] = dataclasses.replace(mo, velocity=Constant(0.0))
+        if "slide_roll" in si:  # dimensionless: the same number in SI
+            srr = check_finite("[si] slide_roll", si["slide_roll"], "2 is pure sliding, 0 pure rolling.")
+            mo = changes.get("motion", scene.motion)
+            changes["motion"] = dataclasses.replace(mo, slide_roll=Constant(srr))
         if visco & set(si):
             if not {"G0", "tau"} <= set(si):
                 raise SceneFileError(
@@ -371,16 +375,17 @@ def _fluid(raw, path) -> dict:
 
 
 def _motion(raw, path) -> Motion:
-    """[motion.gap], [motion.velocity], [motion.load] -> Motion (shared by 2-D and line scenes)."""
+    """[motion.gap], [motion.velocity], [motion.slide_roll], [motion.load] -> Motion (shared by
+    2-D and line scenes)."""
     motion = raw.get("motion", {})
     if not isinstance(motion, dict):
         raise SceneFileError(f"{path}: [motion] must be a table.")
     motion = dict(motion)
-    extra = set(motion) - {"gap", "velocity", "load", "mass", "force", "hc_dot0"}
+    extra = set(motion) - {"gap", "velocity", "slide_roll", "load", "mass", "force", "hc_dot0"}
     if extra:
         raise SceneFileError(
-            f"{path}: [motion] takes gap, velocity, load, and for a free indenter mass, force and "
-            f"hc_dot0, not {sorted(extra)}."
+            f"{path}: [motion] takes gap, velocity, slide_roll, load, and for a free indenter mass, "
+            f"force and hc_dot0, not {sorted(extra)}."
         )
     gap = _time_function(motion.get("gap", {"kind": "ramp_hold"}), "motion.gap", path)
     vel = _time_function(motion.get("velocity", 0.0), "motion.velocity", path)
@@ -388,6 +393,8 @@ def _motion(raw, path) -> Motion:
     if "load" in motion:
         load = _time_function(motion["load"], "motion.load", path)
     free = {}
+    if "slide_roll" in motion:
+        free["slide_roll"] = _time_function(motion["slide_roll"], "motion.slide_roll", path)
     if "force" in motion:
         free["force"] = _time_function(motion["force"], "motion.force", path)
     free.update({k: motion[k] for k in ("mass", "hc_dot0") if k in motion})

@@ -1,25 +1,29 @@
-"""Steady sliding of a rigid cylinder on a standard-linear-solid Winkler foundation.
+"""Steady rolling and sliding of a rigid cylinder on a standard-linear-solid Winkler foundation.
 
 Independent of femehl's time stepping: the steady equations are solved directly as a
 two-point boundary value problem by collocation (:func:`scipy.integrate.solve_bvp`).
 
-At steady sliding (V, hc constant) the line contact of :mod:`femehl.problem.line` on the foundation
-``Viscoelastic(G0, tau, G_inf, elastic=Winkler(k))`` has the film
+At a steady state (V, SRR, hc constant) the line contact of :mod:`femehl.problem.line` on the
+foundation ``Viscoelastic(G0, tau, G_inf, elastic=Winkler(k))`` has the film
 ``d = hc + x^2/2 + J0 p/k + q``; the Reynolds equation integrates once to a constant
 flux (as in :mod:`femehl.reference.line_steady`) and the creep's memory equation
-``tau_c Dq/Dt = dJ p/k - q`` with ``D/Dt = -2 V d/dx`` (the material moves at ``-2V``)
+``tau_c Dq/Dt = dJ p/k - q`` with ``D/Dt = -2 U_s d/dx`` (the material moves at ``-2 U_s``,
+``U_s = V (1 + SRR/2)/2`` the substrate surface's speed, :meth:`femehl.Motion.surface_speeds`)
 is an ODE along x::
 
-    beta d^3 p' = -V (d - d_*),        -2 V tau_c q' = dJ p/k - q,    dJ = J_inf - J0,
+    beta d^3 p' = -V (d - d_*),        -2 U_s tau_c q' = dJ p/k - q,    dJ = J_inf - J0,
     p(-L) = p(L) = 0,   q(L) = 0  (the material enters at x = L unloaded, with no creep),
 
 with ``d_*`` (the film where p' = 0) a free parameter: three conditions for two first
 order equations and one parameter.  The solution is continued in ``dJ`` from the elastic
 one of :mod:`femehl.reference.line_steady` (compliance J0).  Energetics (:mod:`femehl.solver.energetics`,
-per unit length, ``W = -(J0 p/k + q)``)::
+per unit length, ``W = -(J0 p/k + q)``, ``S = U_s - U_i = V SRR/2`` the sliding speed)::
 
-    f = int [V/(6 beta d) - (W + d/2) p'] dx,   D_film = int [V^2/(6 beta d) + (beta/2) d^3 p'^2] dx,
-    P_sliding = -V int W p' dx = V int q p' dx,  and  f V = D_film + P_sliding.
+    f = int [S/(6 beta d) - (W + d/2) p'] dx,   D_film = int [S^2/(6 beta d) + (beta/2) d^3 p'^2] dx,
+    P_sliding = -U_s int W p' dx,   f U_s - T U_i = D_film + P_sliding,
+
+with ``T = int [S/(6 beta d) + (d/2) p'] dx`` the shear force on the cylinder's surface.
+In pure rolling (SRR = 0) ``f`` is the rolling resistance.
 """
 
 from __future__ import annotations
@@ -41,6 +45,7 @@ class SteadyViscoelasticLine:
     film_center: float
     film_min: float
     friction: float
+    shear_indenter: float
     dissipation_film: float
     power_sliding: float
     d_star: float
@@ -51,10 +56,20 @@ class SteadyViscoelasticLine:
 
 
 def steady_viscoelastic_line(
-    k: float, beta: float, hc: float, L: float, V: float, solid, *, tol: float = 1e-8, steps: int = 4
+    k: float,
+    beta: float,
+    hc: float,
+    L: float,
+    V: float,
+    solid,
+    *,
+    slide_roll: float = 2.0,
+    tol: float = 1e-8,
+    steps: int = 4,
 ) -> SteadyViscoelasticLine:
-    """Steady sliding at speed ``V`` and clearance ``hc`` on ``solid`` (a
-    :class:`femehl.Viscoelastic`, its elastic part taken as ``Winkler(k)``) on ``[-L, L]``.
+    """Steady state at velocity ``V``, slide-to-roll ratio ``slide_roll`` and clearance ``hc``
+    on ``solid`` (a :class:`femehl.Viscoelastic`, its elastic part taken as ``Winkler(k)``) on
+    ``[-L, L]``; ``slide_roll = 2`` is the paper's pure sliding, 0 pure rolling.
 
     ``tol`` is solve_bvp's residual tolerance, ``steps`` the continuation steps in dJ.
     """
@@ -63,7 +78,14 @@ def steady_viscoelastic_line(
     from femehl.reference.line_steady import steady_line
 
     if not V > 0.0:
-        raise SceneError(f"the steady sliding reference needs V > 0, got {V!r}.")
+        raise SceneError(f"the steady reference needs V > 0, got {V!r}.")
+    if not (np.isfinite(slide_roll) and slide_roll > -2.0):
+        raise SceneError(
+            f"the steady reference needs the substrate's surface moving toward -x (slide_roll > -2, "
+            f"its material entering at x = L), got slide_roll = {slide_roll!r}."
+        )
+    Ui, Us = 0.5 * V * (1.0 - 0.5 * slide_roll), 0.5 * V * (1.0 + 0.5 * slide_roll)
+    S = Us - Ui
     J0, dJ_end, tc = solid.J0, solid.J_inf - solid.J0, solid.tau_creep
     el = steady_line(k / J0, beta, hc, L, V, full=True)
     x = np.linspace(-L, L, 2001)
@@ -73,7 +95,7 @@ def steady_viscoelastic_line(
 
         def rhs(x, y, par, dJ=dJ):
             d = hc + 0.5 * x * x + J0 * y[0] / k + y[1]
-            return np.vstack([-V * (d - par[0]) / (beta * d**3), (y[1] - dJ * y[0] / k) / (2.0 * V * tc)])
+            return np.vstack([-V * (d - par[0]) / (beta * d**3), (y[1] - dJ * y[0] / k) / (2.0 * Us * tc)])
 
         def bc(ya, yb, par):
             return np.array([ya[0], yb[0], yb[1]])
@@ -95,9 +117,10 @@ def steady_viscoelastic_line(
         load=integral(p),
         film_center=float(hc + J0 * sol.sol(0.0)[0] / k + sol.sol(0.0)[1]),
         film_min=float(d.min()),
-        friction=integral(V / (6.0 * beta * d) - (W + 0.5 * d) * dp),
-        dissipation_film=integral(V * V / (6.0 * beta * d) + 0.5 * beta * d**3 * dp * dp),
-        power_sliding=-V * integral(W * dp),
+        friction=integral(S / (6.0 * beta * d) - (W + 0.5 * d) * dp),
+        shear_indenter=integral(S / (6.0 * beta * d) + 0.5 * d * dp),
+        dissipation_film=integral(S * S / (6.0 * beta * d) + 0.5 * beta * d**3 * dp * dp),
+        power_sliding=-Us * integral(W * dp),
         d_star=float(sol.p[0]),
         x=xs,
         p=p,

@@ -1,11 +1,11 @@
-"""Friction force and energy budget of a sliding lubricated contact, from a State's fields.
+"""Friction force and energy budget of a sliding and rolling lubricated contact, from a State.
 
-The friction force ``f = int [V/(6 beta d) - (W + d/2) dp/dx] dA``, the film's viscous
-dissipation, the sliding power into the substrate (its viscoelastic dissipation in steady
-sliding: ``f V = D_film + P_sliding``) and a free indenter's collision budget, in
-normalized units (half disks doubled; per unit length for line contact).  The derivation
-in physical units, the normalization and the friction coefficient: docs/design.md
-section 15 ("The friction force and the energy budget").
+The friction force ``f = int [S/(6 beta d) - (W + d/2) dp/dx] dA`` (``S`` the sliding
+speed), the film's viscous dissipation, the power the pressure delivers to the moving
+substrate (its viscoelastic dissipation in a steady state) and a free indenter's collision
+budget, in normalized units (half disks doubled; per unit length for line contact).  The
+derivation, the balance ``f U_s - (shear on the indenter) U_i = D_film + P_sliding`` and
+the friction coefficient: docs/design.md section 15 ("The friction force and the energy budget").
 """
 
 from __future__ import annotations
@@ -15,8 +15,17 @@ import numpy as np
 from femehl.elastic.viscoelastic import ENERGETICS_COLUMNS  # the columns the substrate reports
 from femehl.errors import SceneError
 
-__all__ = ["ENERGETICS_COLUMNS", "FREE_COLUMNS", "TRIBOLOGY_COLUMNS", "sliding_energetics"]
+__all__ = [
+    "ENERGETICS_COLUMNS",
+    "FREE_COLUMNS",
+    "FRICTION_COLUMNS",
+    "TRIBOLOGY_COLUMNS",
+    "sliding_energetics",
+]
 
+#: the per-step figures every run on a discretization with pressure gradients reports (the
+#: finite-element disk and line contact): the friction force and its three parts
+FRICTION_COLUMNS = ("friction", "shear_couette", "shear_poiseuille", "pressure_drag")
 #: the per-step figures a run on a viscoelastic substrate reports (summary.csv)
 #: ... and a run of a free indenter (its collision's energy budget)
 FREE_COLUMNS = ("dissipation_film", "elastic_energy")
@@ -32,7 +41,7 @@ TRIBOLOGY_COLUMNS = (
 )
 
 
-def sliding_energetics(disc, state, beta: float) -> dict:
+def sliding_energetics(disc, state, beta: float, speeds=None) -> dict:
     """Friction force, film dissipation and sliding power into the substrate of ``state``.
 
     Parameters
@@ -43,13 +52,20 @@ def sliding_energetics(disc, state, beta: float) -> dict:
     state : femehl.State
     beta : float
         The scene's film parameter.
+    speeds : (float, float), optional
+        The surfaces' speeds ``(U_i, U_s)`` along -x of the indenter and the substrate at
+        ``state.t`` (:meth:`femehl.Motion.surface_speeds`); default ``(0, state.V)``, pure
+        sliding (the paper).
 
     Returns
     -------
     dict
-        ``friction`` (= ``shear_couette + shear_poiseuille + pressure_drag``), its three
-        parts, ``dissipation_film``, ``power_sliding`` and ``elastic_energy``, normalized as
-        in docs/design.md section 15.
+        ``friction`` (= ``shear_couette + shear_poiseuille + pressure_drag``: the force along
+        x on the indenter's axis), its three parts, ``dissipation_film``, ``power_sliding``
+        (the pressure's power into the moving substrate, ``U_s int p dW/dx dA``) and
+        ``elastic_energy``, normalized as in docs/design.md section 15.  The shear force on
+        the indenter's surface is ``shear_couette + shear_poiseuille``; in a steady state
+        ``friction U_s - (shear_couette + shear_poiseuille) U_i = dissipation_film + power_sliding``.
     """
     grad = getattr(disc, "pressure_gradient", None)
     if grad is None:
@@ -62,16 +78,17 @@ def sliding_energetics(disc, state, beta: float) -> dict:
     gp = [np.asarray(g @ p).ravel() for g in G]
     d = np.asarray(state.d, dtype=float)
     W = np.asarray(state.w, dtype=float)
-    V = float(state.V)
+    Ui, Us = (0.0, float(state.V)) if speeds is None else (float(speeds[0]), float(speeds[1]))
+    S = Us - Ui  # the sliding speed
     mult = 2.0 if getattr(disc, "half", False) else 1.0
     a = mult * area
     gx, g2 = gp[0], sum(g * g for g in gp)
     out = {
-        "shear_couette": float(a @ (V / (6.0 * beta * d))),
+        "shear_couette": float(a @ (S / (6.0 * beta * d))),
         "shear_poiseuille": float(a @ (0.5 * d * gx)),
         "pressure_drag": float(-(a @ ((W + d) * gx))),
-        "dissipation_film": float(a @ (V * V / (6.0 * beta * d) + 0.5 * beta * d**3 * g2)),
-        "power_sliding": float(-V * (a @ (W * gx))),
+        "dissipation_film": float(a @ (S * S / (6.0 * beta * d) + 0.5 * beta * d**3 * g2)),
+        "power_sliding": float(-Us * (a @ (W * gx))),
         "elastic_energy": float(0.5 * (a @ (np.asarray(disc.average() @ p).ravel() * -W))),
     }
     out["friction"] = out["shear_couette"] + out["shear_poiseuille"] + out["pressure_drag"]

@@ -132,9 +132,7 @@ class LaggedStepper:
         from femehl.solver.energetics import TRIBOLOGY_COLUMNS
 
         # the energy budget's figures the scene reports (femehl.solver.energetics), where the method has them
-        self._tribology = [c for c in extra_columns(scene) if c in TRIBOLOGY_COLUMNS]
-        if not hasattr(disc, "pressure_gradient"):
-            self._tribology = []
+        self._tribology = [c for c in extra_columns(scene, disc) if c in TRIBOLOGY_COLUMNS]
         self._FC: dict[str, object] = {}
         self._rows_cache: dict[int, np.ndarray] = {}
         self.info = dict(disc.info)
@@ -295,7 +293,7 @@ class LaggedStepper:
         if self._tribology:
             from femehl.solver.energetics import sliding_energetics
 
-            e = sliding_energetics(self.disc, state, self.beta)
+            e = sliding_energetics(self.disc, state, self.beta, self.scene.motion.surface_speeds(state.t))
             state.info.update({k: e[k] for k in self._tribology})
 
     # ---- one step -----------------------------------------------------------------------

@@ -116,6 +116,13 @@ class _Model:
         """The columns' values at p = 0 (the initial state)."""
         return dict.fromkeys(self.columns, 0.0)
 
+    @staticmethod
+    def liquid_fraction(disc, state):
+        """The liquid's share of each element's film, which the Couette shear acts on
+        (:mod:`femehl.solver.energetics`); None: the whole film, as the Reynolds and
+        half-Sommerfeld conditions say nothing of a cavity's content."""
+        return None
+
     def finish(self, stepper, solved, new):
         """The state the step returns, from ``new`` (built from the solved pressure) and
         ``solved`` (:class:`femehl.solver.parts.Solved`: the operator without held rows, its
@@ -282,7 +289,7 @@ class JFOCavitation(_Model):
         p >= 0,   theta <= 1,   p (1 - theta) = 0,
 
     full film (``theta = 1``, Reynolds) where ``p > 0``, cavitated (``p = 0``, the content
-    carried by the sliding surface) where ``theta < 1``.  Flux continuity across a moving
+    carried at the entrainment velocity) where ``theta < 1``.  Flux continuity across a moving
     rupture or reformation front is part of the conservation law: rupture and
     reformation both conserve mass (the jump of ``theta`` at reformation is the JFO
     condition).
@@ -365,6 +372,14 @@ class JFOCavitation(_Model):
         info = dict(state.info)
         info["liquid_volume"] = self.plane * float(self.content_weight @ state.d)
         return dataclasses.replace(state, info=info).with_own(gas=np.zeros(self.transport.n))
+
+    @staticmethod
+    def liquid_fraction(disc, state):
+        """Each element's filling ``1 - (P v)/d`` (the gas film's element average over the gap)."""
+        v = state.own.get("gas")
+        if v is None:
+            return None
+        return np.clip(1.0 - np.asarray(disc.average() @ v).ravel() / np.asarray(state.d), 0.0, 1.0)
 
     def point_fields(self, disc, state) -> dict:
         """``gas_film`` (``v``) and ``film_content`` (``theta = 1 - v/dbar``, 1 where full)."""

@@ -41,7 +41,7 @@ TRIBOLOGY_COLUMNS = (
 )
 
 
-def sliding_energetics(disc, state, beta: float, speeds=None) -> dict:
+def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> dict:
     """Friction force, film dissipation and sliding power into the substrate of ``state``.
 
     Parameters
@@ -56,6 +56,10 @@ def sliding_energetics(disc, state, beta: float, speeds=None) -> dict:
         The surfaces' speeds ``(U_i, U_s)`` along -x of the indenter and the substrate at
         ``state.t`` (:meth:`femehl.Motion.surface_speeds`); default ``(0, state.V)``, pure
         sliding (the paper).
+    liquid : array, optional
+        The liquid's share of each element's film (a mass-conserving cavity's filling,
+        :meth:`femehl.problem.cavitation.JFOCavitation.liquid_fraction`): the Couette shear
+        and its dissipation act on it; default the whole film.
 
     Returns
     -------
@@ -83,11 +87,12 @@ def sliding_energetics(disc, state, beta: float, speeds=None) -> dict:
     mult = 2.0 if getattr(disc, "half", False) else 1.0
     a = mult * area
     gx, g2 = gp[0], sum(g * g for g in gp)
+    couette = S / (6.0 * beta * d) * (1.0 if liquid is None else np.asarray(liquid, dtype=float))
     out = {
-        "shear_couette": float(a @ (S / (6.0 * beta * d))),
+        "shear_couette": float(a @ couette),
         "shear_poiseuille": float(a @ (0.5 * d * gx)),
         "pressure_drag": float(-(a @ ((W + d) * gx))),
-        "dissipation_film": float(a @ (S * S / (6.0 * beta * d) + 0.5 * beta * d**3 * g2)),
+        "dissipation_film": float(a @ (S * couette + 0.5 * beta * d**3 * g2)),
         "power_sliding": float(-Us * (a @ (W * gx))),
         "elastic_energy": float(0.5 * (a @ (np.asarray(disc.average() @ p).ravel() * -W))),
     }

@@ -293,7 +293,9 @@ class LaggedStepper:
         if self._tribology:
             from femehl.solver.energetics import sliding_energetics
 
-            e = sliding_energetics(self.disc, state, self.beta, self.scene.motion.surface_speeds(state.t))
+            speeds = self.scene.motion.surface_speeds(state.t)
+            liquid = None if self.cavitation is None else self.cavitation.liquid_fraction(self.disc, state)
+            e = sliding_energetics(self.disc, state, self.beta, speeds, liquid)
             state.info.update({k: e[k] for k in self._tribology})
 
     # ---- one step -----------------------------------------------------------------------
@@ -328,12 +330,12 @@ class LaggedStepper:
         if Cp is None:
             Cp = np.asarray(self.C @ p).ravel()
         new = self._state(state.step + 1, t_new, hc, ctx.V, p, Cp, state.d, dt, info, film)
-        self._budget(new)
         if own:
             new = new.with_own(**own)
         for part, aux in zip(self.parts, auxes, strict=True):
             solved = Solved(state, ctx, op, rhs, p, Cp, x[n:], aux, film, scale)
             new = part.finish(self, solved, new)
+        self._budget(new)  # from the parts' own variables too (a cavity's gas)
         return new
 
     def _context(self, state: State, t_new: float, dt: float) -> StepContext:

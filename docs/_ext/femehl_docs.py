@@ -28,7 +28,13 @@ from sphinx.util import logging
 logger = logging.getLogger(__name__)
 
 #: examples the gallery executes (each runs in seconds); the others are shown, not run
-GALLERY_EXECUTED = ("custom_shape", "cylinder_winkler", "ellipsoid_sliding", "load_controlled")
+GALLERY_EXECUTED = (
+    "custom_shape",
+    "cylinder_winkler",
+    "ellipsoid_sliding",
+    "load_controlled",
+    "rolling_traction",
+)
 
 GALLERY_HEADER = """\
 Example gallery

@@ -276,6 +276,8 @@ def _run(args, argv=()):
     for t in sorted({1.0, float(res.t[-1])}):
         if res.t[0] - 1e-9 <= t <= res.t[-1] + 1e-9:  # a resumed run starts at its checkpoint
             cav = "".join(f", {c} {res.value_at(c, t):.5g}" for c in res.cavitation_columns)
+            if "friction" in res.extra_columns:
+                cav += f", friction {res.value_at('friction', t):.5g}"
             print(
                 f"  t = {t:g}: load {_with_error(res, 'load', t)}, central film "
                 f"{_with_error(res, 'film_center', t)}, minimum film {_with_error(res, 'film_min', t)}" + cav

@@ -80,9 +80,10 @@ def test_history_figure_axes_and_error_band(run):
     table = dict(table, err_film_min=np.full(table["t"].size, 0.05))
     fig = plots.history_figure(table)
     axes = fig.get_axes()
-    assert len(axes) == 5  # load, peak pressure, hc with V on a twin axis, films
-    load_ax, p_ax, hc_ax, film_ax, v_ax = axes
+    assert len(axes) == 6  # load, peak pressure, hc with V on a twin axis, films, friction
+    load_ax, p_ax, hc_ax, film_ax, f_ax, v_ax = axes
     assert film_ax.get_yscale() == "log"
+    assert np.allclose(f_ax.get_lines()[0].get_ydata(), res.friction)
     assert np.allclose(load_ax.get_lines()[0].get_ydata(), res.load)
     assert np.allclose(v_ax.get_lines()[0].get_ydata(), res.V)
     # the band: (1 -+ 5 %) of the minimum film, as a filled polygon on the film axis
@@ -207,7 +208,7 @@ def test_cli_plot_commands(run, tmp_path, capsys):
     frames = len(list(folder.glob("fields_*.vtu")))
     assert Image.open(tmp_path / "a.gif").n_frames == frames
     # the figure sizes the code sets (inches x dpi): history 7.5 x 9 at 100, maps 11 x 4.8 at 100
-    assert Image.open(tmp_path / "h.png").size == (750, 900)
+    assert Image.open(tmp_path / "h.png").size == (750, 1125)  # five panels (the friction force the fifth)
     assert Image.open(tmp_path / "m.png").size == (1100, 480)
     assert "femehl: wrote" in capsys.readouterr().out
 

@@ -265,15 +265,18 @@ _PHASE_COLOURS = {"indentation": "#dde6f5", "start-up": "#f7e6cf", "steady": "#d
 
 
 def history_figure(table: dict, title: str = ""):
-    """Load, peak pressure, hc and V, central and minimum film against t (a Figure).
+    """Load, peak pressure, hc and V, central and minimum film, and the friction force with
+    its parts where the table has them, against t (a Figure).
 
     ``table``: summary columns (:func:`result_table`, or
     :func:`~femehl.output.table.read_summary` of a run folder's ``summary.csv``).
     """
     plt = _plt()
     t = np.asarray(table["t"], dtype=float)
-    fig, axs = plt.subplots(4, 1, figsize=(7.5, 9.0), sharex=True)
-    ax_load, ax_p, ax_hc, ax_film = axs
+    friction = "friction" in table and np.any(np.isfinite(np.asarray(table["friction"], dtype=float)))
+    rows = 5 if friction else 4
+    fig, axs = plt.subplots(rows, 1, figsize=(7.5, 2.25 * rows), sharex=True)
+    ax_load, ax_p, ax_hc, ax_film = axs[:4]
 
     def band(ax, name, color, label):
         v = np.asarray(table[name], dtype=float)
@@ -298,7 +301,7 @@ def history_figure(table: dict, title: str = ""):
     ax_hc.plot(t, table["hc"], color="C2", label="hc (indenter height)")
     ax_hc.set_ylabel("hc")
     ax_v = ax_hc.twinx()
-    ax_v.plot(t, table["V"], color="C4", ls="--", label="V (sliding speed)")
+    ax_v.plot(t, table["V"], color="C4", ls="--", label="V (the surfaces' speeds, summed)")
     ax_v.set_ylabel("V")
     lines = ax_hc.get_lines() + ax_v.get_lines()
     ax_hc.legend(lines, [ln.get_label() for ln in lines], fontsize=7, loc="best")
@@ -307,8 +310,20 @@ def history_figure(table: dict, title: str = ""):
     if np.all(np.asarray(table["film_min"]) > 0):
         ax_film.set_yscale("log")
     ax_film.set_ylabel("film thickness")
-    ax_film.set_xlabel("t")
     ax_film.legend(fontsize=7, loc="best")
+    if friction:
+        ax_f = axs[4]
+        ax_f.plot(t, table["friction"], color="k", label="friction")
+        for name, label, style in (
+            ("shear_couette", "Couette shear", "--"),
+            ("shear_poiseuille", "Poiseuille shear", ":"),
+            ("pressure_drag", "pressure on the indenter", "-."),
+        ):
+            if name in table:
+                ax_f.plot(t, table[name], ls=style, lw=1.0, label=label)
+        ax_f.set_ylabel("friction force")
+        ax_f.legend(fontsize=7, loc="best")
+    axs[-1].set_xlabel("t")
     for name, a, b in phases(table):
         for ax in axs:
             ax.axvspan(a, b, color=_PHASE_COLOURS[name], zorder=0, lw=0)

@@ -99,7 +99,8 @@ def test_rolling_resistance_against_the_steady_reference(tau):
     1.4e-5, P_sliding 4.7e-5 / 7.4e-6 off at tau = 0.3 / 1; tolerances as for sliding
     (test_viscoelastic_steady: the 400-element mesh's spatial error, 3x the largest).
     The run's own energy budget closes: friction U_s - (shear on the cylinder) U_i =
-    D_film + P_sliding, to the quadrature of its P1 fields."""
+    D_film + P_sliding, measured 2.3e-5 / 6.8e-6 / 6.9e-6 (the quadrature of its P1 fields
+    and what is left of the transient), tolerance 1e-4."""
     ref = steady_viscoelastic_line(K, BETA, HC, L, V, sls(tau), slide_roll=0.0)
     r = femehl.solve(
         LineScene(k=K, beta=BETA, viscoelastic=sls(tau), motion=rolling(0.0)), t_end=12.0, tol=1e-2
@@ -111,7 +112,7 @@ def test_rolling_resistance_against_the_steady_reference(tau):
     Ui, Us = r.scene.motion.surface_speeds(12.0)
     shear = r.shear_couette[-1] + r.shear_poiseuille[-1]
     budget = r.friction[-1] * Us - shear * Ui
-    assert budget == pytest.approx(r.dissipation_film[-1] + r.power_sliding[-1], rel=1e-3)
+    assert budget == pytest.approx(r.dissipation_film[-1] + r.power_sliding[-1], rel=1e-4)
 
 
 def test_rolling_resistance_peaks_at_a_deborah_number_of_order_one():

@@ -209,6 +209,7 @@ class ReynoldsCavitation(_Model):
         free[fixed] = False
         info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
         info["full_film_source"] = _plane_factor(stepper.disc) * float(lam.sum())
+        _mark_unsettled(solved, info)
         return dataclasses.replace(new, info=info).with_own(p_aux=y)
 
 
@@ -481,7 +482,16 @@ class JFOCavitation(_Model):
         if S.any():  # 1 - v / dbar, dbar the mean gap of the node's cell (its row's content)
             theta = float(np.min(1.0 - v[S] / dbar[S]))
         info["theta_min"] = theta
+        _mark_unsettled(solved, info)
         return dataclasses.replace(new, info=info).with_own(p_aux=y, gas=v, gas_prev=fixed["gas"])
+
+
+def _mark_unsettled(solved, info) -> None:
+    """A step solved before the lagged set existed (the first: every node full, the pressure
+    of full Sommerfeld) has a load that is no level of the run's history, whatever the step:
+    ``info["load_unsettled"]`` tells the adaptive steps to judge the load from the others."""
+    if solved.state.own.get("p_aux") is None:
+        info["load_unsettled"] = True
 
 
 def _plane_factor(disc) -> float:

@@ -158,13 +158,17 @@ def _load(state: State) -> float:
 
 def _predict(run: _Run, levels, t):
     """The film and load extrapolated to ``t``; the load of an instant substrate from the
-    levels after its (re)start only (linear from two, None from fewer)."""
+    levels after its (re)start only, and never from a step a part marks ``load_unsettled``
+    (a cavitation set not formed yet), linear from two levels, None from fewer."""
     w = _lagrange([s.t for s in levels], t)
     d_pred = sum(wi * np.asarray(s.d, dtype=float) for wi, s in zip(w, levels, strict=True))
+    kept = [s for s in levels if not (s.info or {}).get("load_unsettled")]
     if run.instant:
-        levels = [s for s in levels if s.t > run.origin]
-        if len(levels) < 2:
+        kept = [s for s in kept if s.t > run.origin]
+    if len(kept) < len(levels):
+        if len(kept) < 2:
             return d_pred, None
+        levels = kept
         w = _lagrange([s.t for s in levels], t)
     load_pred = float(sum(wi * _load(s) for wi, s in zip(w, levels, strict=True)))
     return d_pred, load_pred

@@ -244,7 +244,8 @@ def sample_shape(scene) -> SampledShape:
     """The scene's indenter sampled on the polar grid (96 rays, 801 radii)."""
     th, r, S = _polar_gap(scene)
     radii = getattr(scene.indenter, "curvature_radii", None)
-    return SampledShape(th, r, S, tuple(float(v) for v in radii()) if callable(radii) else None)
+    radii = radii() if callable(radii) else None  # None: not a paraboloid with axes along x, y
+    return SampledShape(th, r, S, None if radii is None else tuple(float(v) for v in radii))
 
 
 @dataclass(frozen=True)

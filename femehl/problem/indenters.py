@@ -33,6 +33,7 @@ Shapes
 
 from __future__ import annotations
 
+import math
 import pathlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,7 +42,7 @@ from typing import ClassVar
 import numpy as np
 
 from femehl.errors import SceneError
-from femehl.validation import check_positive, check_shape_values
+from femehl.validation import check_finite, check_positive, check_shape_values
 
 __all__ = [
     "INDENTERS",
@@ -115,43 +116,70 @@ class Sphere:
 
 @dataclass(frozen=True)
 class Ellipsoid:
-    """An elliptic paraboloid ``s(x, y) = x^2 / (2 Rx) + y^2 / (2 Ry)``.
+    """An elliptic paraboloid ``s = x'^2 / (2 Rx) + y'^2 / (2 Ry)`` in its own axes ``(x', y')``,
+    turned by ``angle`` from the motion's x axis.
 
-    The indenter slides along +x.  ``Rx < Ry`` makes the contact an ellipse
-    elongated across the sliding direction (the long axis along y), as in a
-    ball-on-groove or a crowned roller; ``Rx > Ry`` elongates it along x.
+    The film is entrained along x (the indenter slides along +x).  ``Rx < Ry`` makes the
+    contact an ellipse elongated across the motion (the long axis along y), as in a
+    ball-on-groove or a crowned roller; ``Rx > Ry`` elongates it along x; an ``angle``
+    inclines its axes to the motion (a skewed roller), on the full disk.
 
     Parameters
     ----------
     Rx, Ry : float
-        Radii of curvature in the x (sliding) and y directions, in units of
-        the normalizing radius R* (> 0).
+        Radii of curvature along its own axes, in units of the normalizing radius R* (> 0);
+        at ``angle = 0`` along the motion (x) and across it (y).
+    angle : float, default: 0.0
+        The angle in degrees from the motion's x axis to the ``Rx`` axis, counterclockwise.
     """
 
     Rx: float = 1.0
     Ry: float = 1.0
-    symmetric_y = True
-    si_units: ClassVar[dict] = {"Rx": "curvature", "Ry": "curvature"}
+    angle: float = field(default=0.0, metadata={"describe": "omit_default"})
+    si_units: ClassVar[dict] = {"Rx": "curvature", "Ry": "curvature", "angle": "angle"}
 
     def __post_init__(self):
         hint = "Give positive radii of curvature, e.g. Ellipsoid(Rx=0.5, Ry=2.0)."
         object.__setattr__(self, "Rx", _positive("Ellipsoid radius of curvature Rx", self.Rx, hint))
         object.__setattr__(self, "Ry", _positive("Ellipsoid radius of curvature Ry", self.Ry, hint))
+        object.__setattr__(
+            self, "angle", check_finite("Ellipsoid angle", self.angle, "Give the angle in degrees, e.g. 30.")
+        )
 
     @property
     def axisymmetric(self) -> bool:
         """True only for Rx == Ry (a sphere)."""
         return self.Rx == self.Ry
 
+    @property
+    def _quarter_turns(self):
+        """The angle in quarter turns when it is a whole number of them (None otherwise)."""
+        q = self.angle / 90.0
+        return int(round(q)) % 4 if q == round(q) else None
+
+    @property
+    def symmetric_y(self) -> bool:
+        """Symmetric about the motion's axis: its axes along x and y (or a sphere)."""
+        return self.axisymmetric or self._quarter_turns is not None
+
     def gap(self, x, y):
         """Rigid gap shape s(x, y) (>= 0, zero at the tip), broadcast over arrays."""
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
-        return x * x / (2.0 * self.Rx) + y * y / (2.0 * self.Ry)
+        Rx, Ry = self.curvature_radii() if self._quarter_turns is not None else (self.Rx, self.Ry)
+        if self._quarter_turns is None:  # the coordinates along its own axes
+            a = math.radians(self.angle)
+            c, s = math.cos(a), math.sin(a)
+            x, y = c * x + s * y, c * y - s * x
+        return x * x / (2.0 * Rx) + y * y / (2.0 * Ry)
 
-    def curvature_radii(self) -> tuple[float, float]:
-        """Principal radii of curvature ``(Rx, Ry)`` along x and y (Hertz elliptic contact)."""
-        return self.Rx, self.Ry
+    def curvature_radii(self) -> tuple[float, float] | None:
+        """The radii of curvature ``(Rx, Ry)`` along x and y when they are principal (Hertz
+        elliptic contact); None for axes inclined to the motion."""
+        q = self._quarter_turns
+        if q is None:
+            return None
+        return (self.Rx, self.Ry) if q % 2 == 0 else (self.Ry, self.Rx)
 
     def domain_hint(self, L: float, rise: tuple) -> str:
         """How to choose Rx, Ry so that the gap's rise on the domain r <= L lies in ``rise``."""
@@ -509,5 +537,8 @@ def si_indenter(kind: str, params: dict, dim) -> object:
     scale = {"curvature": dim.R, "length": dim.length}
     out = {}
     for k, v in params.items():
-        out[k] = _positive(f"{kind} {k} [m]", v) / scale[units[k]]
+        if units[k] == "angle":  # degrees, the same in SI
+            out[k] = check_finite(f"{kind} {k} [degrees]", v)
+        else:
+            out[k] = _positive(f"{kind} {k} [m]", v) / scale[units[k]]
     return cls(**out)

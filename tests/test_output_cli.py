@@ -14,7 +14,7 @@ import femehl
 from femehl.api import run_to_folder
 from femehl.cli import main
 from femehl.output import COLUMNS
-from femehl.solver.energetics import FRICTION_COLUMNS
+from femehl.solver.energetics import FRICTION_COLUMNS, SIDE_COLUMNS
 
 
 def _sources(points, n):
@@ -45,7 +45,8 @@ def test_run_writes_readable_series(tmp_path, method, opts):
         sc, tmp_path, method=method, t_end=0.3, dt=0.05, store_every=2, log=lambda *a: None, **opts
     )
     head, data = _read_csv(tmp_path / "summary.csv")
-    assert tuple(head) == COLUMNS + (FRICTION_COLUMNS if method == "fe" else ())  # fe: dp/dx per element
+    # fe: the friction from dp/dx per element, and across the motion on a disk
+    assert tuple(head) == COLUMNS + (FRICTION_COLUMNS + SIDE_COLUMNS if method == "fe" else ())
     assert data.shape[0] == res.nsteps + 1 == 7
     assert np.allclose(data[:, head.index("load")], res.load, rtol=1e-9, atol=1e-12)
     root = ET.parse(tmp_path / "fields.pvd").getroot()

@@ -575,6 +575,7 @@ def test_result_table_in_si():
         "shear_couette",
         "shear_poiseuille",
         "pressure_drag",
+        "side_force",
         "friction_coefficient",
     }
     assert np.allclose(tab["t"], res.t * DIM.time)

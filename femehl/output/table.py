@@ -41,13 +41,13 @@ def extra_columns(scene, disc=None) -> tuple:
     substrate's (``substrate.columns``, e.g. a viscoelastic solid's sliding energy budget)
     and a free indenter's; read from ``state.info``."""
     from femehl.problem.cavitation import cavitation_columns
-    from femehl.solver.energetics import FREE_COLUMNS, FRICTION_COLUMNS
+    from femehl.solver.energetics import FREE_COLUMNS, FRICTION_COLUMNS, SIDE_COLUMNS
 
     if scene is None:
         return ()
     cols = cavitation_columns(scene)
     if hasattr(disc, "pressure_gradient"):
-        cols += FRICTION_COLUMNS
+        cols += FRICTION_COLUMNS + (SIDE_COLUMNS if getattr(disc, "dimension", 1) == 2 else ())
     cols += tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
     if getattr(getattr(scene, "motion", None), "free", False):  # a free indenter's energy budget
         cols += FREE_COLUMNS

@@ -890,6 +890,7 @@ class Dimensional:
         "shear_couette": ("shear_couette", "tangential_force", "N"),
         "shear_poiseuille": ("shear_poiseuille", "tangential_force", "N"),
         "pressure_drag": ("pressure_drag", "tangential_force", "N"),
+        "side_force": ("side_force", "tangential_force", "N"),
         "dissipation_film": ("dissipation_film", "power", "W"),
         "power_sliding": ("power_sliding", "power", "W"),
         "elastic_energy": ("elastic_energy", "energy", "J"),

@@ -19,6 +19,7 @@ __all__ = [
     "ENERGETICS_COLUMNS",
     "FREE_COLUMNS",
     "FRICTION_COLUMNS",
+    "SIDE_COLUMNS",
     "TRIBOLOGY_COLUMNS",
     "sliding_energetics",
 ]
@@ -26,12 +27,15 @@ __all__ = [
 #: the per-step figures every run on a discretization with pressure gradients reports (the
 #: finite-element disk and line contact): the friction force and its three parts
 FRICTION_COLUMNS = ("friction", "shear_couette", "shear_poiseuille", "pressure_drag")
+#: ... and a disk's: the force across the motion (zero on a half disk, by symmetry)
+SIDE_COLUMNS = ("side_force",)
 #: the per-step figures a run on a viscoelastic substrate reports (summary.csv)
 #: ... and a run of a free indenter (its collision's energy budget)
 FREE_COLUMNS = ("dissipation_film", "elastic_energy")
 #: every figure :func:`sliding_energetics` computes
 TRIBOLOGY_COLUMNS = (
     "friction",
+    "side_force",
     "shear_couette",
     "shear_poiseuille",
     "pressure_drag",
@@ -67,7 +71,9 @@ def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> di
         ``friction`` (= ``shear_couette + shear_poiseuille + pressure_drag``: the force along
         x on the indenter's axis), its three parts, ``dissipation_film``, ``power_sliding``
         (the pressure's power into the moving substrate, ``U_s int p dW/dx dA``) and
-        ``elastic_energy``, normalized as in docs/design.md section 15.  The shear force on
+        ``elastic_energy``, normalized as in docs/design.md section 15; on a disk also
+        ``side_force``, the force across the motion ``-int (W + d/2) dp/dy dA`` (0 on a
+        half disk, by symmetry).  The shear force on
         the indenter's surface is ``shear_couette + shear_poiseuille``; in a steady state
         ``friction U_s - (shear_couette + shear_poiseuille) U_i = dissipation_film + power_sliding``.
     """
@@ -97,4 +103,6 @@ def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> di
         "elastic_energy": float(0.5 * (a @ (np.asarray(disc.average() @ p).ravel() * -W))),
     }
     out["friction"] = out["shear_couette"] + out["shear_poiseuille"] + out["pressure_drag"]
+    if len(gp) > 1:  # across the motion: Poiseuille shear and pressure (no Couette along y)
+        out["side_force"] = 0.0 if getattr(disc, "half", False) else float(-(a @ ((W + 0.5 * d) * gp[1])))
     return out

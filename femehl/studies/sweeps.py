@@ -54,7 +54,7 @@ RESULT_COLUMNS = (
     ("t", "hc", "V", "load", "film_center", "film_min", "p_max")
     + tuple(f"err_{q}{part}" for q in ("load", "film_center", "film_min") for part in ("", "_space", "_time"))
     + ("load_full", "cavitated_area", "full_film_source")
-    + ("friction", "shear_couette", "shear_poiseuille", "pressure_drag")
+    + ("friction", "shear_couette", "shear_poiseuille", "pressure_drag", "side_force")
     + ("dissipation_film", "power_sliding", "elastic_energy")
 )
 #: statuses a case.json can have; "done" and "failed" are finished (skipped on a re-run)

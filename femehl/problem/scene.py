@@ -748,7 +748,8 @@ class Dimensional:
     eta : float
         Fluid viscosity [Pa s].
     V_ss : float
-        Steady sliding speed [m/s] (also sets the time scale).
+        Steady speed [m/s] (also sets the time scale): the sum of the two surfaces' speeds,
+        twice the entrainment speed; in the paper's pure sliding, the sliding speed.
     h_inf : float
         Final indentation depth [m] (length scale of film and deflection).
     nu : float, default: 0.5
@@ -901,7 +902,10 @@ class Dimensional:
 
     def unit(self, column: str) -> str:
         """The SI unit of a column of :meth:`result_table`."""
-        return {**{k: v[2] for k, v in self.RESULT_COLUMNS.items()}, **self.DERIVED_COLUMNS}[column]
+        units = {**{k: v[2] for k, v in self.RESULT_COLUMNS.items()}, **self.DERIVED_COLUMNS}
+        if column not in units:
+            raise SceneError(f"no SI column {column!r}; the columns are {sorted(units)}.")
+        return units[column]
 
     def result_table(self, result) -> dict:
         """The per-step table of a normalized ``result`` in SI units.

@@ -233,6 +233,26 @@ def test_error_garbage_file(tmp_path, suffix, capsys):
     assert out.out == "" and out.err == ""  # meshio's chatter is captured
 
 
+def test_reading_a_mesh_leaves_sys_streams_alone(ladder, tmp_path, monkeypatch):
+    """A mesh read in one thread (a sweep's case) must not swap sys.stdout/stderr for the
+    process: the main thread's messages printed meanwhile would go into the swapped stream."""
+    import sys
+
+    from meshio import _helpers
+
+    streams = sys.stdout, sys.stderr
+    seen = []
+    real = _helpers.reader_map["gmsh"]
+
+    def reader(path):
+        seen.append((sys.stdout, sys.stderr))
+        return real(path)
+
+    monkeypatch.setitem(_helpers.reader_map, "gmsh", reader)
+    fm.load_mesh(ladder_path("coarse"))
+    assert seen and all(s[0] is streams[0] and s[1] is streams[1] for s in seen)
+
+
 def test_error_quads_only(tmp_path):
     pts = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
     path = tmp_path / "quads.vtu"

@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import difflib
 import hashlib
-import io
 import json
 import math
 import os
@@ -751,9 +750,33 @@ def _check_l(L) -> None:
         raise MeshError(f"L = {L!r} must be a positive finite number (the disk radius)")
 
 
+def _meshio_read(path: pathlib.Path, file_format: str | None):
+    """``meshio.read`` without its side effects: it prints the error of each format it tries
+    and calls ``sys.exit`` when none works. Redirecting sys.stdout/stderr around it would
+    swap them for the whole process (a sweep's other threads print meanwhile), so the
+    candidate formats are tried here, as meshio does, and their errors collected."""
+    import meshio
+    from meshio import _helpers
+
+    formats, ext = ([file_format] if file_format else []), ""
+    for suffix in reversed(path.suffixes if not file_format else []):
+        ext = (suffix + ext).lower()
+        formats += meshio.extension_to_filetypes.get(ext, [])
+    if not formats:
+        raise meshio.ReadError(f"no format meshio knows ends in {path.suffix or 'no suffix'!r}")
+    said = []
+    for fmt in formats:
+        if fmt not in _helpers.reader_map:
+            raise meshio.ReadError(f"unknown file format {fmt!r}")
+        try:
+            return _helpers.reader_map[fmt](str(path))
+        except meshio.ReadError as exc:
+            said.append(f"as {fmt}: {exc}")
+    raise meshio.ReadError("; ".join(said))
+
+
 def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = None):
     """Read the triangles of a mesh file: nodes (2, n), triangles (3, ne)."""
-    import meshio
 
     if path.is_dir():
         raise MeshError(
@@ -774,20 +797,11 @@ def _read_file(path: pathlib.Path, L: float = 2.0, file_format: str | None = Non
             f"mesh file '{path}' is not readable (permission denied); fix its "
             "permissions or pass a copy you can read"
         )
-    # meshio prints the errors of the formats it tries (.msh: ansys, then gmsh)
-    # and calls sys.exit when none works: capture the output, catch the exit.
-    chatter = io.StringIO()
     try:
-        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
-            m = meshio.read(path, file_format=file_format)
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many kinds: wrap them all
-        said = " ".join(chatter.getvalue().split())
-        if isinstance(exc, SystemExit) or not str(exc):
-            detail = said or type(exc).__name__
-        else:
-            detail = f"{type(exc).__name__}: {exc}"
+        m = _meshio_read(path, file_format)
+    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds: wrap them all
         raise MeshError(
-            f"'{path}' is not a mesh meshio can read ({detail}); "
+            f"'{path}' is not a mesh meshio can read ({type(exc).__name__}: {exc}); "
             f"pass a file in a format meshio reads, {_READABLE}"
         ) from None
     blocks = [np.asarray(c.data) for c in m.cells if c.type == "triangle"]

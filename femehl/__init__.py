@@ -29,6 +29,7 @@ from femehl.errors import (
 from femehl.output.result import Result
 from femehl.problem import indenters, line, presets
 from femehl.problem.indenters import INDENTERS, Ellipsoid, FlatPunch, HeightMap, Shape
+from femehl.problem.roughness import Roughness
 from femehl.problem.scene import (
     Constant,
     Dimensional,
@@ -54,6 +55,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Barus",
     "Roelands",
+    "Roughness",
     "sweep",
     "presets",
     "auto",

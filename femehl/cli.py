@@ -141,6 +141,26 @@ def _parser():
     sw.add_argument("--retry-failed", action="store_true", help="run the cases recorded as failed again")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
     sw.add_argument("--x", help="plot: the parameter on the x axis (default: the first swept number)")
+    st = sub.add_parser(
+        "stribeck",
+        help="the Stribeck curve: a scene's steady state at many speeds, on a Dask cluster",
+    )
+    st.add_argument("scene", help="TOML scene file reaching a steady sliding state by its [run] t_end")
+    st.add_argument(
+        "--speeds",
+        nargs=2,
+        type=float,
+        required=True,
+        metavar=("LO", "HI"),
+        help="the lowest and highest speed: V_ss in m/s for an SI scene, else factors on the scene's speed",
+    )
+    st.add_argument("--num", type=int, default=26, help="number of speeds, evenly spaced in log (default 26)")
+    st.add_argument("--out", help="output folder (default <scene name>-stribeck)")
+    st.add_argument("--scheduler", help="address of an existing Dask scheduler (default: a local cluster)")
+    st.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
+    st.add_argument("--overwrite", action="store_true", help="replace another study's table in the folder")
+    st.add_argument("--retry-failed", action="store_true", help="run the speeds recorded as failed again")
+    st.add_argument("--quiet", action="store_true", help="no progress bar")
     b = sub.add_parser("bench", help="benchmarks (see benchmarks/)")
     b.add_argument(
         "what",
@@ -378,6 +398,53 @@ def _sweep(args) -> int:
     return EXIT_STOPPED
 
 
+def _stribeck(args, argv) -> int:
+    """``femehl stribeck SCENE.toml --speeds LO HI``: the curve's table and picture.
+
+    Exit status: 0 every speed done, 2 bad input (nothing started), 3 some speeds failed
+    (the curve is written with them marked), 130 interrupted (the finished speeds stay;
+    running the same command goes on).
+    """
+    from femehl.studies.stribeck import stribeck
+
+    try:
+        curve = stribeck(
+            args.scene,
+            args.speeds,
+            args.num,
+            out=args.out,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            overwrite=args.overwrite,
+            retry_failed=args.retry_failed,
+            progress=not args.quiet,
+        )
+    except KeyboardInterrupt:
+        print(
+            "femehl: interrupted; the finished speeds stay in the output folder. Running the same "
+            f"command goes on where it stopped:\n  {shlex.join(['femehl', *argv])}",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    for _, row in curve.iterrows():
+        mu = row["friction_coefficient"]
+        print(
+            f"  speed {row['speed']:<10.4g} {row['status']:<7} mu {mu:<10.4g} film/sigma "
+            f"{row['film_over_sigma']:<10.4g} asperities {row['asperity_share']:<7.3f} {row['regime']}"
+            + ("" if row["steady"] or row["status"] != "done" else " (not steady at t_end)")
+        )
+    bad = curve[curve["status"] != "done"]
+    print(f"femehl: wrote {curve.attrs['csv']} and {curve.attrs['png']}")
+    if bad.empty:
+        return EXIT_DONE
+    print(
+        f"femehl: {len(bad)} of {len(curve)} speeds did not finish (their logs: "
+        f"{curve.attrs['csv'].parent}/cases/<key>/run.log); to run them again add --retry-failed.",
+        file=sys.stderr,
+    )
+    return EXIT_STOPPED
+
+
 def _sweep_command(args, *extra) -> str:
     """The ``femehl sweep`` command line of ``args``, plus ``extra``."""
     words = ["femehl", "sweep", args.args[0]]
@@ -567,6 +634,8 @@ def main(argv=None) -> int:
                 return _plot(args)
             if args.command == "sweep":
                 return _sweep(args)
+            if args.command == "stribeck":
+                return _stribeck(args, argv)
             return _bench(args)
         except SolverError as exc:
             print(f"femehl: error: {exc}", file=sys.stderr)

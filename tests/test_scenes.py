@@ -619,5 +619,6 @@ def test_cli_writes_si_summary(tmp_path, capsys):
         rows = list(csv.reader(fh))
     assert rows[0][:4] == ["t_s", "hc_m", "load_N", "film_center_m"]
     data = np.array(rows[1:], dtype=float)
-    assert data[-1, 2] == pytest.approx(0.01, rel=1e-9)  # the imposed load, in N
+    # the imposed load, in N: ramped from 0 over t1 (one time scale by default), then held
+    assert data[-1, 2] == pytest.approx(0.01 * data[-1, 0] / DIM.time, rel=1e-9)
     assert data[0, 1] == pytest.approx(1e-5)

@@ -72,6 +72,7 @@ class SeriesWriter:
         from femehl.problem.cavitation import cavitation_model
 
         self.cavitation = cavitation_model(getattr(getattr(disc, "scene", None), "cavitation", None))
+        self.roughness = getattr(getattr(disc, "scene", None), "roughness", None)
         self.entries: list[tuple[float, str]] = []
         self.next_index = 0  # number of the next file (never one present)
 
@@ -97,6 +98,9 @@ class SeriesWriter:
             point_data["cavitated"] = cav[self._source] if self.mirrored else cav
         if self.cavitation is not None:  # the condition's own nodal fields (JFO: gas, theta)
             for k, v in self.cavitation.point_fields(self.disc, state).items():
+                point_data[k] = v[self._source] if self.mirrored else v
+        if self.roughness is not None:  # the asperities' share of the pressure
+            for k, v in self.roughness.point_fields(self.disc, state).items():
                 point_data[k] = v[self._source] if self.mirrored else v
         mesh = meshio.Mesh(
             self.points,

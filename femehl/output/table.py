@@ -48,6 +48,7 @@ def extra_columns(scene, disc=None) -> tuple:
     cols = cavitation_columns(scene)
     if hasattr(disc, "pressure_gradient"):
         cols += FRICTION_COLUMNS + (SIDE_COLUMNS if getattr(disc, "dimension", 1) == 2 else ())
+    cols += tuple(getattr(getattr(scene, "roughness", None), "columns", ()))
     cols += tuple(getattr(getattr(scene, "substrate", None), "columns", ()))
     if getattr(getattr(scene, "motion", None), "free", False):  # a free indenter's energy budget
         cols += FREE_COLUMNS

@@ -206,6 +206,7 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
     cavitation: str | None = None,
     viscoelastic=None,
     profile: Callable | None = None,
+    roughness=None,
 ) -> Scene:
     """A line contact: a :class:`femehl.Scene` with a :class:`LineDomain`, a rigid cylinder
     (or a ``profile``) on a Winkler foundation ``w = -p/k`` (normalized units, docs/design.md section 4).
@@ -231,6 +232,8 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
         A viscoelastic foundation relaxing the Winkler(k) (its ``elastic`` is replaced).
     profile : callable, optional
         The rigid gap ``s(x)`` of a slider (:class:`Profile`); None: the cylinder ``x^2/2``.
+    roughness : femehl.Roughness, optional
+        The surfaces' combined roughness and asperity contact (:class:`femehl.Scene`'s).
     """
     motion = _default_motion() if motion is None else motion
     if not isinstance(motion, Motion):
@@ -260,6 +263,7 @@ def LineScene(  # noqa: N802 - the line contact's scene, built as the 2-D one is
         fluid=Fluid(beta, viscosity=viscosity, cavitation=cavitation),
         motion=motion,
         domain=LineDomain(L),
+        roughness=roughness,
     )
 
 

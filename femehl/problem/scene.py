@@ -464,6 +464,9 @@ class Scene:
     fluid: Fluid = field(default_factory=Fluid)
     motion: Motion = field(default_factory=Motion)
     domain: Domain = field(default_factory=Domain)
+    #: the surfaces' combined roughness and asperity contact (:class:`femehl.Roughness`);
+    #: None: smooth surfaces, the film must stay open
+    roughness: object = field(default=None, metadata={"describe": "omit_default"})
 
     @property
     def viscosity(self):
@@ -516,8 +519,11 @@ class Scene:
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
         self.domain.check(self)
         from femehl.problem.cavitation import check_cavitation_scene
+        from femehl.problem.roughness import check_roughness
 
         check_cavitation_scene(self)
+        if check_roughness(self.roughness) is not None:
+            self.roughness.check_scene(self)
 
     def _check_domain_holds_contact(self):
         """The domain must reach well past the largest contact of the run, for any indenter.
@@ -895,10 +901,13 @@ class Dimensional:
         "dissipation_film": ("dissipation_film", "power", "W"),
         "power_sliding": ("power_sliding", "power", "W"),
         "elastic_energy": ("elastic_energy", "energy", "J"),
+        # a rough surface's asperities (femehl.problem.roughness)
+        "asperity_load": ("asperity_load", "force", "N"),
+        "asperity_friction": ("asperity_friction", "tangential_force", "N"),
     }
 
     #: columns :meth:`result_table` derives from the others -> SI unit
-    DERIVED_COLUMNS: ClassVar[dict] = {"friction_coefficient": "1"}
+    DERIVED_COLUMNS: ClassVar[dict] = {"friction_coefficient": "1", "asperity_share": "1"}
 
     def unit(self, column: str) -> str:
         """The SI unit of a column of :meth:`result_table`."""
@@ -924,7 +933,8 @@ class Dimensional:
             ``cavitated_area`` [m^2], ``full_film_source`` [m^3/s], the friction force and
             its parts [N] where the result has them (the units are in
             :attr:`RESULT_COLUMNS`), and with the friction the friction coefficient
-            ``friction_coefficient = friction / load`` (NaN while the load is 0).
+            ``friction_coefficient = friction / load`` (NaN while the load is 0); a rough
+            surface's ``asperity_load``, ``asperity_friction`` [N] and ``asperity_share``.
         """
         s = result.summary()
         out = {
@@ -937,7 +947,41 @@ class Dimensional:
                 out["friction_coefficient"] = np.where(
                     out["load"] > 0.0, out["friction"] / out["load"], np.nan
                 )
+        if "asperity_load" in out:  # the asperities' share of the load
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out["asperity_share"] = np.where(
+                    out["load"] > 0.0, out["asperity_load"] / out["load"], np.nan
+                )
         return out
+
+    @property
+    def aspect(self) -> float:
+        """``sqrt(h_inf/R)``: the height scale over the length scale."""
+        return math.sqrt(self.h_inf / self.R)
+
+    def roughness(self, rms, density, radius, summit_rms=None, friction=0.0):
+        """A Greenwood-Tripp :class:`femehl.Roughness` from the surfaces' statistics [SI].
+
+        ``rms`` the combined rms roughness sigma* [m], ``density`` the asperity density n_a
+        [1/m^2], ``radius`` the asperities' radius beta_a [m], ``summit_rms`` the rms of
+        their summits' heights sigma_s [m] (default ``rms``), ``friction`` their boundary
+        friction coefficient. Greenwood & Tripp (1970)::
+
+            p_a = (8 sqrt(2)/15) pi (n_a beta_a sigma_s)^2 sqrt(sigma_s/beta_a) E' F_{5/2}(d/sigma*)
+
+        with ``E' = 2 G/(1 - nu)`` the substrate's plane-strain modulus (the indenter rigid).
+        """
+        from femehl.problem.roughness import Roughness
+
+        rms = check_positive("[si] roughness_rms [m]", rms, "the combined rms roughness of both surfaces")
+        n_a = check_positive("[si] asperity_density [1/m2]", density, "asperities per square metre")
+        b_a = check_positive("[si] asperity_radius [m]", radius, "the asperities' summit radius")
+        s_s = rms if summit_rms is None else check_positive("[si] summit_rms [m]", summit_rms)
+        e_prime = 2.0 * self.G / (1.0 - self.nu)
+        k_si = (
+            (8.0 * math.sqrt(2.0) / 15.0) * math.pi * (n_a * b_a * s_s) ** 2 * math.sqrt(s_s / b_a) * e_prime
+        )
+        return Roughness(rms / self.h_inf, k_si / self.pressure, friction=friction, aspect=self.aspect)
 
     def scene(self, h0: float, t1: float | None = None, T: float | None = None, L: float = 2.0) -> Scene:
         """The paper's ramp-hold-slide experiment for these SI values.

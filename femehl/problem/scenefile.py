@@ -179,7 +179,7 @@ def scene_from_mapping(raw: dict, path) -> tuple:
 
     path = pathlib.Path(path)
     raw = copy.deepcopy(raw)
-    known = {"indenter", "substrate", "fluid", "motion", "domain", "run", "si"}
+    known = {"indenter", "substrate", "fluid", "motion", "domain", "roughness", "run", "si"}
     unknown = set(raw) - known
     if unknown:
         raise SceneFileError(f"{path}: unknown table(s) {sorted(unknown)}; known: {sorted(known)}.")
@@ -200,6 +200,13 @@ def scene_from_mapping(raw: dict, path) -> tuple:
     _check_run(run, path)
     try:
         if "si" in raw:
+            if "roughness" in raw:
+                raise SceneFileError(
+                    f"{path}: [roughness] is stated in normalized units (sigma over h_inf, stiffness "
+                    "over p0); a [si] scene takes its roughness in SI: [si] roughness_rms [m], "
+                    "asperity_density [1/m2], asperity_radius [m] (optional summit_rms [m], "
+                    "boundary_friction)."
+                )
             scene, dim = _si_scene(raw, path)
             run["_dimensional"] = dim
         else:
@@ -209,6 +216,22 @@ def scene_from_mapping(raw: dict, path) -> tuple:
     except SceneError as exc:
         raise SceneFileError(f"{path}: {exc}") from None
     return scene, run
+
+
+def _roughness(raw, path):
+    """[roughness] sigma, stiffness and friction (femehl.Roughness), or None."""
+    from femehl.problem.roughness import Roughness
+
+    table = raw.get("roughness")
+    if table is None:
+        return None
+    keys = {"sigma", "stiffness", "friction", "aspect"}
+    if not isinstance(table, dict) or set(table) - keys or not {"sigma", "stiffness"} <= set(table):
+        raise SceneFileError(
+            f"{path}: [roughness] takes sigma and stiffness (and friction with aspect), got "
+            f"{sorted(table) if isinstance(table, dict) else table!r}."
+        )
+    return Roughness(**table)
 
 
 def _check_run(run: dict, path: pathlib.Path) -> None:
@@ -255,7 +278,8 @@ def _si_scene(raw, path):
     visco = {"G0", "tau", "G_inf"}  # a standard linear solid: unrelaxed modulus, relaxation time
     free = {"mass", "force", "hc_dot0", "sliding"}  # a free indenter: kg, N, m/s; sliding on/off
     free |= {"cavitation", "slide_roll"}  # [fluid] cavitation; the slide-to-roll ratio (2: sliding)
-    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco | free
+    rough = {"roughness_rms", "asperity_density", "asperity_radius", "summit_rms", "boundary_friction"}
+    optional = {"nu", "t1", "T", "L", "load", "alpha", "roelands_Z", "layer_thickness"} | visco | free | rough
     keys = {"R", "G", "eta", "V_ss", "h_inf", "h0"} | optional
     extra = set(si) - keys
     missing = (keys - optional) - set(si)
@@ -284,10 +308,12 @@ def _si_scene(raw, path):
                     f"[si] layer_thickness must be > 0 (metres), got {h:g}; leave it out for a half space."
                 )
             changes["substrate"] = Layer(h / dim.length, nu=dim.nu)
-        if "load" in si:
+        if "load" in si:  # applied over the indentation ramp's time t1, then held (not at once: the
+            # pressure and the film at the rim jump at an impulsive start, which no step resolves)
             F = check_finite("[si] load [N]", si["load"]) / dim.force
+            t1 = scene.motion.gap.breakpoints[0]
             changes["motion"] = dataclasses.replace(
-                scene.motion, gap=Constant(scene.motion.hc(0.0)), load=Constant(F)
+                scene.motion, gap=Constant(scene.motion.hc(0.0)), load=RampHold(0.0, F, t1)
             )
         if "alpha" in si or "roelands_Z" in si:  # pressure-viscosity: Barus [1/Pa], or Roelands
             from femehl.problem.viscosity import Barus, Roelands
@@ -317,6 +343,20 @@ def _si_scene(raw, path):
                 mass=m / dim.mass,
                 force=check_finite("[si] force [N]", si.get("force", 0.0)) / dim.force,
                 hc_dot0=check_finite("[si] hc_dot0 [m/s]", si.get("hc_dot0", 0.0)) / dim.approach_speed,
+            )
+        if rough & set(si):  # a rough surface: Greenwood-Tripp from the surfaces' statistics
+            need = {"roughness_rms", "asperity_density", "asperity_radius"}
+            if need - set(si):
+                raise SceneFileError(
+                    f"{path}: [si] a rough surface needs {sorted(need)} (optional summit_rms [m], "
+                    f"boundary_friction); missing {sorted(need - set(si))}."
+                )
+            changes["roughness"] = dim.roughness(
+                si["roughness_rms"],
+                si["asperity_density"],
+                si["asperity_radius"],
+                si.get("summit_rms"),
+                si.get("boundary_friction", 0.0),
             )
         if "cavitation" in si:
             fluid = changes.get("fluid", scene.fluid)
@@ -357,7 +397,12 @@ def _normalized_scene(raw, path):
     if not isinstance(domain, dict) or set(domain) - {"L"}:
         raise SceneFileError(f"{path}: [domain] takes only L.")
     return Scene(
-        indenter=indenter, substrate=substrate, fluid=Fluid(**fluid), motion=motion, domain=Domain(**domain)
+        indenter=indenter,
+        substrate=substrate,
+        fluid=Fluid(**fluid),
+        motion=motion,
+        domain=Domain(**domain),
+        roughness=_roughness(raw, path),
     )
 
 
@@ -459,6 +504,7 @@ def _line_scene(raw, path):
         raise SceneFileError(f"{path}: [domain] takes only L.")
     kw = {"k": winkler.k, "motion": motion, **({"viscoelastic": visco} if visco is not None else {})}
     kw.update({k: fluid[k] for k in ("beta", "viscosity", "cavitation") if k in fluid})
+    kw["roughness"] = _roughness(raw, path)
     if "L" in domain:
         kw["L"] = domain["L"]
     try:

@@ -96,6 +96,9 @@ class _Run:
     #: the load jumps at the (re)start ``origin`` where hc' does, which is no time error
     instant: bool = False
     origin: float = -math.inf
+    #: the first state does not carry the imposed load (an impulsive start, F(t0) != its
+    #: load): the first step is a jump, accepted alone, and the run restarts after it
+    jump: bool = False
     stops: list = field(default_factory=list)  # the breakpoints ahead, then t_end
     trial: tuple = (math.nan, math.nan)  # the trial step proposed: (t_new, h)
     #: ``settled(states)``: the film points the estimate reads (None: all), from the fluid's
@@ -136,9 +139,10 @@ def _lagrange(ts, t) -> np.ndarray:
 
 def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) -> float:
     """``max( max_i |d_i - d_pred_i| / d_i, |F - F_pred| / max|F| )`` (docs/design.md section 3.1);
-    the film alone when ``load_pred`` is None."""
+    the film alone when ``load_pred`` is None.  Where a part lets the film close
+    (``info["film_error_floor"]``: a rough surface's sigma), the film's scale is at least that."""
     d = np.asarray(trial.d, dtype=float)
-    rel = np.abs(d - d_pred) / d
+    rel = np.abs(d - d_pred) / np.maximum(d, (trial.info or {}).get("film_error_floor", 0.0))
     keep = None if run.settled is None else run.settled([*run.levels, trial])
     if keep is not None and keep.any():
         rel = rel[keep]
@@ -148,6 +152,17 @@ def _norm(run: _Run, trial: State, d_pred: np.ndarray, load_pred: float | None) 
     load = _load(trial)
     scale = max(run.load_scale, abs(load), LOAD_FLOOR)
     return max(err, abs(load - load_pred) / scale)
+
+
+def _impulsive(scene, state: State) -> bool:
+    """True when an imposed load is applied at once: ``F(t0)`` is not the first state's load
+    (a constant load from rest).  The pressure and hc jump at ``t0+``, and the film near
+    the rim with them (by an amount that depends on the first step, not on its error)."""
+    mo = getattr(scene, "motion", None)
+    if mo is None or not getattr(mo, "load_controlled", False) or getattr(mo, "free", False):
+        return False
+    F = float(mo.F(state.t))
+    return abs(F - _load(state)) > 1e-9 * max(abs(F), LOAD_FLOOR)
 
 
 def _load(state: State) -> float:
@@ -369,6 +384,7 @@ class AdaptiveSteps:
             instant=bool(getattr(getattr(scene, "substrate", None), "instant", False)),
             origin=state.t,
             stops=stops,
+            jump=_impulsive(scene, state),
         )
         self._run.recent.append(state)
         return state
@@ -410,6 +426,15 @@ class AdaptiveSteps:
             _reject(run, 1, max(RETRY_FACTOR * h, dt_min), fail.reason, t_new, h)
             return
         run.load_scale = max(run.load_scale, abs(_load(trial)))
+        if run.jump:  # an impulsive start: no error estimate spans the jump; restart after it
+            run.jump = False
+            yield from _emit(run, trial, run.rejected, math.nan)
+            run.rejected = 0
+            run.levels = [without_history(trial)]
+            run.origin = trial.t
+            logger.debug("adaptive: impulsive start, restart at t = %.6g", trial.t)
+            yield from self._arrived()
+            return
         if len(run.levels) == 1:  # the Euler start step: judged with the next step
             run.levels.append(trial)
             run.pending, run.pending_rejected, run.rejected = trial, run.rejected, 0

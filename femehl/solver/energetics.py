@@ -45,7 +45,9 @@ TRIBOLOGY_COLUMNS = (
 )
 
 
-def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> dict:
+def sliding_energetics(
+    disc, state, beta: float, speeds=None, liquid=None, p_solid=None, gap=None, solid_friction=0.0
+) -> dict:
     """Friction force, film dissipation and sliding power into the substrate of ``state``.
 
     Parameters
@@ -64,6 +66,15 @@ def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> di
         The liquid's share of each element's film (a mass-conserving cavity's filling,
         :meth:`femehl.problem.cavitation.JFOCavitation.liquid_fraction`): the Couette shear
         and its dissipation act on it; default the whole film.
+    p_solid, gap, solid_friction : optional
+        A rough contact's (:meth:`femehl.problem.roughness.AsperityContact.budget`): the
+        asperities' share of the pressure on the free nodes (the film's is ``p - p_solid``),
+        the film's mean gap per film point (default ``state.d``) and the asperities'
+        friction force, added to ``friction``. The budget then has two more terms:
+        ``dissipation_solid = solid_friction * S`` and ``power_roughness``
+        ``= U_s int (h_T - d) dp_film/dx dA``, the film pressure's power into the substrate's
+        rough layer (the part ``d - h_T`` of the separation the asperities take, carried
+        at ``U_s``; docs/design.md section 18).
 
     Returns
     -------
@@ -85,24 +96,31 @@ def sliding_energetics(disc, state, beta: float, speeds=None, liquid=None) -> di
         )
     (G, area) = grad()
     p = np.asarray(state.p, dtype=float)[disc.free_index]
-    gp = [np.asarray(g @ p).ravel() for g in G]
+    gp = [np.asarray(g @ p).ravel() for g in G]  # the pressure on the indenter: film and asperities
+    pf = p if p_solid is None else p - np.asarray(p_solid, dtype=float)
+    gf = gp if p_solid is None else [np.asarray(g @ pf).ravel() for g in G]  # the film's
     d = np.asarray(state.d, dtype=float)
+    h = d if gap is None else np.asarray(gap, dtype=float)  # the film's mean gap
     W = np.asarray(state.w, dtype=float)
     Ui, Us = (0.0, float(state.V)) if speeds is None else (float(speeds[0]), float(speeds[1]))
     S = Us - Ui  # the sliding speed
     mult = 2.0 if getattr(disc, "half", False) else 1.0
     a = mult * area
-    gx, g2 = gp[0], sum(g * g for g in gp)
-    couette = S / (6.0 * beta * d) * (1.0 if liquid is None else np.asarray(liquid, dtype=float))
+    gx, fx, f2 = gp[0], gf[0], sum(g * g for g in gf)
+    couette = S / (6.0 * beta * h) * (1.0 if liquid is None else np.asarray(liquid, dtype=float))
     out = {
         "shear_couette": float(a @ couette),
-        "shear_poiseuille": float(a @ (0.5 * d * gx)),
+        "shear_poiseuille": float(a @ (0.5 * h * fx)),
         "pressure_drag": float(-(a @ ((W + d) * gx))),
-        "dissipation_film": float(a @ (S * couette + 0.5 * beta * d**3 * g2)),
+        "dissipation_film": float(a @ (S * couette + 0.5 * beta * h**3 * f2)),
         "power_sliding": float(-Us * (a @ (W * gx))),
         "elastic_energy": float(0.5 * (a @ (np.asarray(disc.average() @ p).ravel() * -W))),
     }
-    out["friction"] = out["shear_couette"] + out["shear_poiseuille"] + out["pressure_drag"]
+    out["friction"] = out["shear_couette"] + out["shear_poiseuille"] + out["pressure_drag"] + solid_friction
+    if p_solid is not None:
+        out["dissipation_solid"] = float(solid_friction * S)
+        out["power_roughness"] = float(Us * (a @ ((h - d) * fx)))
     if len(gp) > 1:  # across the motion: Poiseuille shear and pressure (no Couette along y)
-        out["side_force"] = 0.0 if getattr(disc, "half", False) else float(-(a @ ((W + 0.5 * d) * gp[1])))
+        side = (W + d) * gp[1] - 0.5 * h * gf[1]
+        out["side_force"] = 0.0 if getattr(disc, "half", False) else float(-(a @ side))
     return out

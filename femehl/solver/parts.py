@@ -19,6 +19,13 @@ class StepPart:
     pressure the lagged coefficients use), :meth:`film` (a change of the step's film
     ``d = h + offset + scale C p``: a memory), :meth:`rows` (rows held or unknowns added
     to the step's system), :meth:`finish` (its variables after the step).
+
+    Two optional hooks, for a part that changes the terms themselves (a rough surface,
+    :class:`femehl.problem.roughness.AsperityContact`): ``context(stepper, state, ctx)``
+    returns the terms' lagged context changed (a rough film's mean gap), and
+    ``operator(stepper, ctx, D, G)`` returns ``[(F, rhs), ...]``, sparse film operators on
+    the step's ``d^{k+1}`` (coefficient 1) and right-hand sides added to the terms' (``D``
+    their matrix, ``G`` their film operators summed).
     """
 
     def initial(self, stepper, state):

@@ -124,10 +124,13 @@ class LaggedStepper:
             self.cavitation.setup(disc)
         memory = getattr(substrate, "memory", None)  # a viscoelastic substrate's internal variable
         self.memory = None if memory is None else memory(disc)
+        rough = getattr(scene, "roughness", None)
+        self.roughness = None if rough is None else rough.part(disc)
         #: what takes part in the step beside the terms (femehl.solver.parts): the motion's
-        #: unknown hc, then the substrate's memory and the fluid's cavitation condition
+        #: unknown hc, then the substrate's memory, the fluid's cavitation condition and the
+        #: surfaces' roughness
         self.gap = gap_control(scene.motion)
-        self.parts = [part for part in (self.memory, self.cavitation) if part is not None]
+        self.parts = [part for part in (self.memory, self.cavitation, self.roughness) if part is not None]
         from femehl.output.table import extra_columns
         from femehl.solver.energetics import TRIBOLOGY_COLUMNS
 
@@ -197,7 +200,26 @@ class LaggedStepper:
                 rhs += c.rhs
         if D is None:
             D = sp.csr_matrix((self.disc.n, self.disc.n))
-        return StepOperator(D=D.tocsr(), films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
+        D = D.tocsr()
+        adds = [part.operator for part in self.parts if hasattr(part, "operator")]
+        if adds:
+            G = sum((F * (c / scale) for c, F, _ in films), sp.csr_matrix((self.disc.n, self.C.shape[0])))
+            for add in adds:  # film operators of this step only (a rough film's)
+                for F, r in add(self, ctx, D, G):
+                    films.append((scale, F, self._step_product(F)))
+                    rhs += r
+        return StepOperator(D=D, films=films, C=self.C, key=ctx.a0 / ctx.dt), rhs
+
+    def _step_product(self, F):
+        """``F C`` of a film operator of one step: only the columns F uses are touched."""
+        F = sp.csr_matrix(F)
+        cols = np.unique(F.indices)
+        Fc = F[:, cols]
+        if self.fast:
+            return sp.csr_matrix(Fc @ sp.csr_matrix(self.C.preconditioner)[cols])
+        if self.dense:
+            return np.asarray(Fc @ self.C[cols])
+        return sp.csr_matrix(Fc @ sp.csr_matrix(self.C)[cols])
 
     # ---- states -------------------------------------------------------------------------
     def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, mem=None) -> State:
@@ -295,7 +317,8 @@ class LaggedStepper:
 
             speeds = self.scene.motion.surface_speeds(state.t)
             liquid = None if self.cavitation is None else self.cavitation.liquid_fraction(self.disc, state)
-            e = sliding_energetics(self.disc, state, self.beta, speeds, liquid)
+            rough = {"liquid": liquid} if self.roughness is None else self.roughness.budget(state)
+            e = sliding_energetics(self.disc, state, self.beta, speeds, **rough)
             state.info.update({k: e[k] for k in self._tribology})
 
     # ---- one step -----------------------------------------------------------------------
@@ -344,8 +367,9 @@ class LaggedStepper:
         a0, a1, a2, l0, l1 = self.scheme.coefficients(omega)
         if l1 == 0.0:
             d_lag, hist = state.d, state.d
-        else:  # extrapolated coefficient, kept positive
-            d_lag = np.maximum(l0 * state.d - l1 * state.d_prev, 0.5 * state.d)
+        else:  # extrapolated coefficient, kept positive (a film through contact, d <= 0: as is)
+            d_lag = l0 * state.d - l1 * state.d_prev
+            d_lag = np.where(state.d > 0.0, np.maximum(d_lag, 0.5 * state.d), d_lag)
             hist = a1 * state.d - a2 * state.d_prev
         free_index = self.disc.free_index
         p_old = state.p[free_index]
@@ -353,7 +377,7 @@ class LaggedStepper:
             lagged = part.lagged(state, free_index)
             p_old = p_old if lagged is None else lagged
         self.solver.rtol_scale = film_rtol_scale(state.d, state.w)  # the residual follows the film
-        return StepContext(
+        ctx = StepContext(
             t_new=t_new,
             dt=dt,
             a0=a0,
@@ -366,6 +390,10 @@ class LaggedStepper:
             a1=a1,
             a2=a2,
         )
+        for part in self.parts:
+            if hasattr(part, "context"):
+                ctx = part.context(self, state, ctx)
+        return ctx
 
     def _film(self, state: State, t_new: float, dt: float):
         """The step's change of the film (``d = h + offset + scale C p``), at most one part's."""

@@ -296,9 +296,10 @@ def film_floor(state: State) -> tuple:
 
 def film_positive(state: State) -> bool:
     """True when every film ``state`` knows of is finite and > 0 (the test of
-    :func:`_check_film`, without raising)."""
+    :func:`_check_film`, without raising); only finite where a part carries the load
+    through contact (``state.info["film_may_close"]``: a rough surface's asperities)."""
     d = film_floor(state)[0]
-    return math.isfinite(d) and d > 0.0
+    return math.isfinite(d) and (d > 0.0 or bool(state.info.get("film_may_close")))
 
 
 def _check_film(state: State):

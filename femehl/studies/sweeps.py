@@ -49,13 +49,15 @@ logger = logging.getLogger("femehl")
 #: expert run, e.g. ``mesh = "fitted"`` with ``dt``, has the parts only), and the figures
 #: of a cavitation condition (:data:`femehl.problem.cavitation.CAVITATION_COLUMNS`), the
 #: friction force and its parts (:data:`femehl.solver.energetics.FRICTION_COLUMNS`) and a
-#: viscoelastic substrate's energy budget; NaN for a case without one, or without that figure
+#: viscoelastic substrate's energy budget and a rough surface's asperities
+#: (:data:`femehl.problem.roughness.ROUGH_COLUMNS`); NaN for a case without one, or without that figure
 RESULT_COLUMNS = (
     ("t", "hc", "V", "load", "film_center", "film_min", "p_max")
     + tuple(f"err_{q}{part}" for q in ("load", "film_center", "film_min") for part in ("", "_space", "_time"))
     + ("load_full", "cavitated_area", "full_film_source")
     + ("friction", "shear_couette", "shear_poiseuille", "pressure_drag", "side_force")
     + ("dissipation_film", "power_sliding", "elastic_energy")
+    + ("asperity_load", "asperity_share", "asperity_friction")
 )
 #: statuses a case.json can have; "done" and "failed" are finished (skipped on a re-run)
 FINISHED = ("done", "failed")

@@ -1,0 +1,275 @@
+"""Rough surfaces: asperity contact and the mean gap of a film between rough surfaces.
+
+A :class:`Roughness` on the scene (``Scene(roughness=...)``, TOML ``[roughness]``) makes the
+step's pressure unknown the total pressure ``P`` (what deflects the substrate and carries the
+load), shared between the film and the asperities::
+
+    P = p_film + p_a(d),      p_a(d) = K F_{5/2}(d / sigma)      (Greenwood-Tripp 1970)
+
+on the mean separation ``d = hc + s + C P``.  The Reynolds equation acts on ``p_film`` with
+the mean gap ``h_T(d) = sigma (t Phi(t) + phi(t))``, ``t = d / sigma`` (the expected local gap
+over Gaussian heights of rms ``sigma``) as the film's content and ``h_T^3`` as its mobility.
+Both are linearized about the step's lagged film, as the film coefficients are, so the step
+stays ONE linear system.  The derivation, the energy budget and what is left out (flow
+factors): docs/design.md section 18.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.special import gamma, ndtr, pbdv
+
+from femehl.errors import SceneError
+from femehl.solver.parts import StepPart
+from femehl.validation import check_positive
+
+__all__ = ["Roughness", "AsperityContact", "greenwood_tripp", "mean_gap", "RESIDUAL", "ROUGH_COLUMNS"]
+
+#: the per-step figures a run with a roughness reports (summary.csv, the Result)
+ROUGH_COLUMNS = ("asperity_load", "asperity_share", "asperity_friction")
+
+#: F_n(t) below this t is continued by its tangent (d < -38 sigma: far past any contact the
+#: model describes; D_{-n-1} overflows beyond it); above _T_ZERO it is below 1e-300
+_T_LOW, _T_ZERO = -38.0, 38.0
+#: the residual film where the surfaces are in full contact, over sigma (:func:`mean_gap`)
+RESIDUAL = 0.02
+#: where the asperities and the gap's roughness correction are negligible: F_{5/2}(8.5) < 1e-18
+#: and 1 - Phi(8.5) < 1e-17 of their scale
+_T_CONTACT = 8.5
+
+
+def _gt(t, n):
+    """``F_n(t) = Gamma(n+1) exp(-t^2/4) D_{-n-1}(t) / sqrt(2 pi)`` (parabolic cylinder function)."""
+    t = np.clip(t, _T_LOW, _T_ZERO)
+    return gamma(n + 1.0) * np.exp(-0.25 * t * t) * pbdv(-n - 1.0, t)[0] / math.sqrt(2.0 * math.pi)
+
+
+def greenwood_tripp(t, n: float = 2.5):
+    """``(F_n(t), dF_n/dt)``: the n-th moment of a unit Gaussian above ``t`` and its slope
+    ``-n F_{n-1}(t)``; continued by its tangent below t = -38.  Vectorized."""
+    t = np.asarray(t, dtype=float)
+    F, dF = _gt(t, n), -n * _gt(t, n - 1.0)
+    low = t < _T_LOW
+    if np.any(low):
+        F = np.where(low, F + dF * (t - _T_LOW), F)
+    return F, dF
+
+
+def mean_gap(d, sigma: float):
+    """``(h, dh/dd, Phi)``: the film's mean gap at mean separation ``d`` and its slope, and
+    the wetted fraction ``Phi(t)`` (``t = d/sigma``)::
+
+        h = sigma (t Phi(t) + phi(t) + RESIDUAL (1 - Phi(t))),    dh/dd = Phi(t) - RESIDUAL phi(t)
+
+    ``sigma (t Phi + phi)`` is the expected local gap over Gaussian heights; the residual
+    film ``RESIDUAL sigma`` that remains where the surfaces are in full contact (``t << 0``)
+    keeps the film's mobility, and so the step's system, regular there. ``h -> d`` for
+    ``d >> sigma`` (``1 - Phi(8.5) < 1e-17``)."""
+    t = np.clip(np.asarray(d, dtype=float) / sigma, _T_LOW, None)
+    Phi = ndtr(t)
+    phi = np.exp(-0.5 * t * t) / math.sqrt(2.0 * math.pi)
+    return sigma * (t * Phi + phi + RESIDUAL * (1.0 - Phi)), Phi - RESIDUAL * phi, Phi
+
+
+@dataclass(frozen=True)
+class Roughness:
+    """The combined roughness of the two surfaces and its asperity contact (normalized units).
+
+    Parameters
+    ----------
+    sigma : float
+        The combined rms roughness over ``h_inf`` (``sqrt(sigma_1^2 + sigma_2^2)``).
+    stiffness : float
+        ``K``, the Greenwood-Tripp asperity stiffness over the pressure scale ``p0``:
+        ``p_a = K F_{5/2}(d/sigma)``;
+        :func:`femehl.reference.rough_contact.gt_stiffness` computes it from the asperity
+        density, radius and the summits' rms height.
+    friction : float, default 0
+        The boundary friction coefficient of the asperities: their shear is ``friction``
+        times their pressure, against the sliding (0: frictionless asperities).
+    aspect : float, optional
+        ``sqrt(h_inf/R)``, femehl's height scale over its length scale, needed with a
+        ``friction``: friction forces are in units of ``p0 h_inf sqrt(R h_inf)``, loads in
+        units of ``p0 R h_inf``, so the asperities' friction is ``friction * asperity_load
+        / aspect`` (docs/design.md section 15). An SI scene gives it.
+    """
+
+    sigma: float
+    stiffness: float
+    friction: float = 0.0
+    aspect: float | None = None
+
+    def __post_init__(self):
+        hint = "give the combined rms roughness over h_inf (a positive number)"
+        object.__setattr__(self, "sigma", check_positive("roughness sigma", self.sigma, hint))
+        hint = "give the Greenwood-Tripp stiffness K over p0 (gt_stiffness computes it)"
+        object.__setattr__(self, "stiffness", check_positive("roughness stiffness", self.stiffness, hint))
+        mu = self.friction
+        if isinstance(mu, bool) or not isinstance(mu, (int, float)) or not (math.isfinite(mu) and mu >= 0):
+            raise SceneError(
+                f"roughness friction = {mu!r} must be a finite number >= 0 (the asperities' boundary "
+                "friction coefficient, e.g. 0.1)."
+            )
+        object.__setattr__(self, "friction", float(mu))
+        if self.aspect is not None:
+            hint = "it is sqrt(h_inf/R), e.g. 0.03 for h_inf = 10 um and R = 10 mm"
+            object.__setattr__(self, "aspect", check_positive("roughness aspect", self.aspect, hint))
+        elif mu > 0.0:
+            raise SceneError(
+                f"roughness friction = {mu:g} needs aspect = sqrt(h_inf/R) (femehl's friction force "
+                "and load have different units): give Roughness(..., friction=mu, aspect=sqrt(h_inf/R)), "
+                "or state the scene in SI units, which knows it."
+            )
+
+    columns = ROUGH_COLUMNS
+
+    def solid_friction(self, load, sliding):
+        """The asperities' friction force (femehl's friction unit) at asperity load ``load``
+        and sliding speed ``sliding`` (``U_s - U_i``): against the sliding."""
+        return 0.0 if self.friction == 0.0 else self.friction * float(np.sign(sliding)) * load / self.aspect
+
+    def pressure(self, d):
+        """``(p_a, dp_a/dd)`` at mean separation ``d``."""
+        F, dF = greenwood_tripp(np.asarray(d, dtype=float) / self.sigma, 2.5)
+        return self.stiffness * F, (self.stiffness / self.sigma) * dF
+
+    def mean_gap(self, d):
+        """``(h, dh/dd, wetted fraction)`` at mean separation ``d``: :func:`mean_gap`."""
+        return mean_gap(d, self.sigma)
+
+    def check_scene(self, scene) -> None:
+        if getattr(scene, "cavitation", None) is not None:
+            raise SceneError(
+                f"a rough scene with cavitation = {scene.cavitation!r} is not supported yet: the "
+                "cavitation condition would hold the total pressure, not the film's. Leave cavitation "
+                "out (full Sommerfeld) or the roughness out."
+            )
+
+    @staticmethod
+    def point_fields(disc, state) -> dict:
+        """The asperity pressure on every mesh node (the VTK series' ``asperity_pressure``)."""
+        p_a = state.own.get("p_asperity")
+        return {} if p_a is None else {"asperity_pressure": disc.expand(p_a)}
+
+    def part(self, disc) -> AsperityContact:
+        """The step part that puts this roughness into each lagged step."""
+        return AsperityContact(self, disc)
+
+
+def check_roughness(value):
+    """``value`` if None or a :class:`Roughness`, else SceneError naming the fix."""
+    if value is None or isinstance(value, Roughness):
+        return value
+    raise SceneError(
+        f"roughness must be None (smooth surfaces) or a femehl.Roughness(sigma, stiffness), got "
+        f"{type(value).__name__}."
+    )
+
+
+class AsperityContact(StepPart):
+    """The roughness in each lagged step (:class:`femehl.solver.parts.StepPart`).
+
+    About the lagged film ``d*`` (the terms' ``d_lag``), on the film points::
+
+        p_a(d) ~ a + b d,            a = p_a(d*) - b d*,        b = p_a'(d*) <= 0
+        h_T(d) ~ Phi* d + r,         r = h_T(d*) - Phi* d*
+
+    The terms see the mean gap (their context's films are ``h_T``); their matrix ``D`` acts
+    on the film pressure ``P - N p_a`` (``N``: the film points' values averaged to the
+    nodes) and their film operator ``G`` on ``h_T``. Both corrections are sparse film
+    operators on the step's ``d^{k+1}``, nonzero only on the elements near contact
+    (``d* < 8.5 sigma``): ``-D N diag(b)`` and ``-G diag(1 - Phi*)``.
+    """
+
+    def __init__(self, roughness: Roughness, disc):
+        self.rough = roughness
+        self.disc = disc
+        N = getattr(disc, "node_average", None)
+        free = disc.free_index
+        if N is None:  # the film points are the nodes
+            nf = disc.film_points.shape[0]
+            N = sp.identity(nf, format="csr")
+        self.N = sp.csr_matrix(N)[free]  # free nodes x film points
+        self._lin = None
+
+    # ---- the step ----------------------------------------------------------------------
+    def context(self, stepper, state, ctx):
+        """The terms' context in mean gaps; the linearization point kept for :meth:`operator`."""
+        rough = self.rough
+        d_star = np.asarray(ctx.d_lag, dtype=float)
+        hT_star, Phi, _ = rough.mean_gap(d_star)
+        pa, slope = rough.pressure(d_star)
+        self._lin = (d_star, hT_star, Phi, pa, slope)
+        hT = rough.mean_gap(state.d)[0]
+        if ctx.a2 != 0.0 and state.d_prev is not None:
+            history = ctx.a1 * hT - ctx.a2 * rough.mean_gap(state.d_prev)[0]
+        else:
+            history = hT
+        from femehl.solver.linsolve import film_rtol_scale
+
+        stepper.solver.rtol_scale = film_rtol_scale(hT, state.w)  # the film the solve must resolve
+        return dataclasses.replace(ctx, d=hT, d_lag=hT_star, history=history)
+
+    def operator(self, stepper, ctx, D, G):
+        """``[(F, rhs)]``: film operators on ``d^{k+1}`` and right-hand sides the roughness adds."""
+        d_star, hT_star, Phi, pa, slope = self._lin
+        near = np.flatnonzero(d_star < _T_CONTACT * self.rough.sigma)
+        if near.size == 0:
+            return []
+        nf = d_star.size
+        b = np.zeros(nf)
+        b[near] = slope[near]
+        a = pa - slope * d_star
+        a[d_star >= _T_CONTACT * self.rough.sigma] = 0.0
+        # the asperities' share of the pressure: D acts on P - N (a + b d)
+        DN = sp.csr_matrix(D @ self.N)
+        F = -(DN @ sp.diags(b))
+        rhs = DN @ a
+        # the film's content h_T = Phi* d + r
+        c = np.zeros(nf)
+        c[near] = 1.0 - Phi[near]
+        r = hT_star - Phi * d_star
+        F = F - G @ sp.diags(c)
+        rhs = rhs - G @ np.where(c > 0.0, r, 0.0)
+        return [(sp.csr_matrix(F), np.asarray(rhs).ravel())]
+
+    def finish(self, stepper, solved, new):
+        """The asperity pressure the step solved for (its linearization at the new film)."""
+        d_star, _, _, pa, slope = self._lin
+        pa_new = np.where(d_star < _T_CONTACT * self.rough.sigma, pa + slope * (new.d - d_star), 0.0)
+        return self._report(stepper, new, pa_new)
+
+    def initial(self, stepper, state):
+        return self._report(stepper, state, self.rough.pressure(state.d)[0])
+
+    def _report(self, stepper, state, pa_points):
+        p_a = np.asarray(self.N @ pa_points).ravel()  # on the free nodes
+        load_a = float(stepper.g @ p_a)
+        Ui, Us = stepper.scene.motion.surface_speeds(state.t)
+        info = dict(state.info)
+        info.update(
+            film_may_close=True,  # the asperities carry the load where the film closes
+            film_error_floor=self.rough.sigma,  # the film's scale for the step error: d, at least sigma
+            asperity_load=load_a,
+            asperity_share=load_a / state.load if state.load != 0.0 else float("nan"),
+            asperity_friction=self.rough.solid_friction(load_a, Us - Ui),
+        )
+        return dataclasses.replace(state, info=info).with_own(p_asperity=p_a)
+
+    # ---- what the run reports ------------------------------------------------------------
+    def budget(self, state) -> dict:
+        """What :func:`femehl.solver.energetics.sliding_energetics` needs of the roughness."""
+        p_a = state.own.get("p_asperity")
+        h, _, wetted = self.rough.mean_gap(state.d)
+        return {
+            "p_solid": p_a,
+            "gap": h,
+            # the Couette shear on the wetted fraction, through its mean gap h/wetted
+            "liquid": wetted * wetted,
+            "solid_friction": state.info.get("asperity_friction", 0.0),
+        }

@@ -1,0 +1,260 @@
+"""Rough surfaces (femehl.Roughness): asperity contact through the lagged step.
+
+Checked against independent solutions: the Greenwood-Tripp function by quadrature
+(femehl.reference.rough_contact), the dry rough contact of a line on a Winkler foundation
+(a scalar equation per point, solved here by brentq) and of a sphere on the half space
+(the reference's axisymmetric Newton solve); the smooth limit; the energy budget.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import femehl
+from femehl import Fluid, Motion, RampHold, Roughness, Scene
+from femehl.errors import SceneError, SceneFileError
+from femehl.problem.line import LineScene
+from femehl.problem.roughness import RESIDUAL, greenwood_tripp, mean_gap
+from femehl.reference import rough_contact as ref
+from femehl.solver.adaptive import AdaptiveSteps
+from femehl.solver.energetics import sliding_energetics
+
+
+def test_greenwood_tripp_by_parabolic_cylinder_functions_against_quadrature():
+    # scipy's pbdv is worst near t = 6 (1.1e-9 relative, where F_{5/2} is 1e-10 of its scale),
+    # 1e-13 elsewhere; the reference's quadrature is 5e-14 against mpmath
+    t = np.linspace(-30.0, 30.0, 241)
+    for n in (2.5, 1.5):
+        F, dF = greenwood_tripp(t, n)
+        assert np.max(np.abs(F / ref.greenwood_tripp(t, n) - 1.0)) < 2e-9
+        assert np.max(np.abs(dF / ref.greenwood_tripp_derivative(t, n) - 1.0)) < 2e-9
+    F, dF = greenwood_tripp(np.array([-50.0, -40.0]), 2.5)  # continued by the tangent, finite
+    assert np.all(np.isfinite(F)) and np.all(dF < 0) and F[0] > F[1]
+
+
+def test_mean_gap_limits_and_slope():
+    """The expected local gap over Gaussian heights, plus the residual film in full contact."""
+    sigma, eps = 0.05, RESIDUAL
+    h, slope, wet = mean_gap(np.array([0.0, 10 * sigma, -10 * sigma]), sigma)
+    assert h[0] == pytest.approx(sigma * (1 / math.sqrt(2 * math.pi) + eps / 2), rel=1e-14)
+    assert h[1] == pytest.approx(10 * sigma, rel=1e-15) and slope[1] == pytest.approx(1.0, abs=1e-15)
+    assert h[2] == pytest.approx(eps * sigma, rel=1e-12) and wet[2] < 1e-20
+    d = np.linspace(-3 * sigma, 3 * sigma, 13)
+    step = 1e-6 * sigma
+    fd = (mean_gap(d + step, sigma)[0] - mean_gap(d - step, sigma)[0]) / (2 * step)
+    assert np.allclose(fd, mean_gap(d, sigma)[1], rtol=1e-8, atol=1e-12)
+    assert np.all(mean_gap(np.linspace(-30, 30, 601) * sigma, sigma)[1] > 0)  # h rises with d
+
+
+def _line_dry(rough, k, hc, x):
+    """The dry rough contact of the cylinder on Winkler(k) at hc: P = p_a(hc + x^2/2 + P/k)."""
+
+    def P(xi):
+        top = rough.pressure(hc + xi * xi / 2)[0]
+        return (
+            0.0 if top < 1e-300 else brentq(lambda q: q - rough.pressure(hc + xi * xi / 2 + q / k)[0], 0, top)
+        )
+
+    return np.array([P(xi) for xi in x])
+
+
+@pytest.mark.parametrize("k, hc", [(1.0, -0.1), (10.0, -0.3)])
+def test_zero_speed_line_is_the_dry_rough_contact(k, hc):
+    """No sliding, the gap held: the film drains and the asperities carry the whole load, as the
+    independent pointwise solution says; at k = 10 the mean separation goes below zero (through
+    contact, where a smooth film would have to close)."""
+    rough = Roughness(sigma=0.05, stiffness=2.0)
+    scene = LineScene(
+        k=k, L=2.0, beta=1e4, motion=Motion(gap=RampHold(0.2, hc, 1.0), velocity=0.0), roughness=rough
+    )
+    res = femehl.solve(scene, t_end=30.0, n_elements=400, step_tol=1e-4, estimate=False)
+    x = np.linspace(-2, 2, 4001)
+    load = np.trapezoid(_line_dry(rough, k, hc, x), x)
+    assert res.value_at("load", 30.0) / load - 1 == pytest.approx(0.0, abs=2e-4)  # measured 4.4e-5 (k = 1)
+    assert res.value_at("asperity_share", 30.0) == pytest.approx(1.0, abs=1e-6)
+    if k == 10.0:
+        assert res.value_at("film_min", 30.0) < 0.0  # the mean planes overlap: the asperities carry it
+
+
+def test_zero_speed_sphere_is_the_rough_contact_reference():
+    """The FE disk (coarse ladder mesh, half space) at rest under a held gap, against the
+    axisymmetric Newton solution of the same Greenwood-Tripp law (femehl.reference)."""
+    sigma, K, hc = 0.1, 1.0, -0.5
+    scene = Scene(
+        fluid=Fluid(beta=1e5),
+        motion=Motion(gap=RampHold(0.2, hc, 1.0), velocity=0.0),
+        roughness=Roughness(sigma, K),
+    )
+    res = femehl.solve(scene, t_end=5.0, mesh="coarse", step_tol=1e-4, estimate=False)
+    reference = ref.rough_sphere_contact(hc, sigma, K, L=2.0)
+    assert res.value_at("load", 5.0) / reference.load - 1 == pytest.approx(0.0, abs=1.5e-3)  # measured 4.9e-4
+    assert res.value_at("asperity_share", 5.0) == pytest.approx(1.0, abs=1e-6)
+
+
+def test_thick_film_is_the_smooth_run():
+    """Far from contact (film >= 15 sigma) the roughness changes nothing: F_{5/2}(15) ~ 1e-52."""
+    motion = Motion(gap=0.1, velocity=1.0, load=RampHold(0.0, 0.5, 1.0))
+    runs = [
+        femehl.solve(
+            LineScene(k=1.0, beta=10.0, motion=motion, roughness=r),
+            t_end=3.0,
+            n_elements=200,
+            dt=0.01,
+            estimate=False,
+        )
+        for r in (None, Roughness(sigma=0.005, stiffness=1.0))
+    ]
+    assert runs[1].film_min.min() > 15 * 0.005
+    for q in ("load", "film_min", "film_center", "friction", "hc"):
+        assert np.allclose(getattr(runs[1], q), getattr(runs[0], q), rtol=1e-10, atol=1e-14)
+    assert np.all(runs[1].asperity_load < 1e-80)  # F_{5/2}(20) at the start
+
+
+def _mixed_steady(srr, n=400, T=60.0):
+    rough = Roughness(sigma=0.05, stiffness=2.0, friction=0.1, aspect=0.5)
+    motion = Motion(gap=0.2, velocity=0.05, slide_roll=srr, load=RampHold(0.0, 0.5, 1.0))
+    scene = LineScene(k=1.0, L=2.5, beta=10.0, motion=motion, roughness=rough)
+    stepper = femehl.make_stepper(scene, n_elements=n, scheme="bdf2")
+    state = list(femehl.march(stepper, T, AdaptiveSteps(tol=1e-5, dt0=1e-3)))[-1]
+    speeds = scene.motion.surface_speeds(T)
+    e = sliding_energetics(stepper.disc, state, scene.fluid.beta, speeds, **stepper.roughness.budget(state))
+    return state, speeds, e
+
+
+@pytest.mark.parametrize("srr, tol", [(2.0, 5e-4), (0.0, 2e-3)])
+def test_energy_budget_of_a_mixed_steady_state(srr, tol):
+    """f U_s - T U_i = D_film + P_sliding + D_solid + power_roughness (design.md section 16),
+    at a steady state where the asperities carry about 3/4 of the load; the remainder is the
+    discretization's (200 / 400 / 800 elements at SRR 0: 1.8e-3 / 8.4e-4 / 5.9e-4)."""
+    state, (Ui, Us), e = _mixed_steady(srr)
+    assert 0.6 < state.info["asperity_share"] < 0.85
+    shear = e["shear_couette"] + e["shear_poiseuille"] + state.info["asperity_friction"]
+    power = e["friction"] * Us - shear * Ui
+    assert e["dissipation_solid"] == pytest.approx(0.2 * (Us - Ui) * state.info["asperity_load"], rel=1e-12)
+    spent = e["dissipation_film"] + e["power_sliding"] + e["dissipation_solid"] + e["power_roughness"]
+    assert abs(power - spent) < tol * power
+
+
+def test_bad_roughness_input():
+    for kw in (
+        {"sigma": 0.0, "stiffness": 1.0},
+        {"sigma": float("nan"), "stiffness": 1.0},
+        {"sigma": 0.1, "stiffness": -1.0},
+        {"sigma": 0.1, "stiffness": 1.0, "friction": -0.1},
+        {"sigma": 0.1, "stiffness": 1.0, "friction": True},
+        {"sigma": 0.1, "stiffness": 1.0, "friction": 0.1},  # no aspect: the friction's unit is unknown
+        {"sigma": 0.1, "stiffness": 1.0, "friction": 0.1, "aspect": 0.0},
+    ):
+        with pytest.raises(SceneError):
+            Roughness(**kw)
+    with pytest.raises(SceneError, match="femehl.Roughness"):
+        Scene(roughness=0.1)
+    with pytest.raises(SceneError, match="not supported yet"):
+        Scene(fluid=Fluid(cavitation="reynolds"), roughness=Roughness(0.1, 1.0))
+
+
+def test_scene_file_roughness(tmp_path):
+    from femehl.problem.scenefile import load_scene_file
+
+    f = tmp_path / "a.toml"
+    f.write_text("[roughness]\nsigma = 0.05\nstiffness = 2.0\nfriction = 0.2\naspect = 0.03\n")
+    assert load_scene_file(f)[0].roughness == Roughness(0.05, 2.0, 0.2, 0.03)
+    f.write_text("[roughness]\nsigma = 0.05\n")
+    with pytest.raises(SceneFileError, match="takes sigma and stiffness"):
+        load_scene_file(f)
+    f.write_text("[si]\nR = 0.01\n[roughness]\nsigma = 0.05\nstiffness = 2.0\n")
+    with pytest.raises(SceneFileError, match="normalized units"):
+        load_scene_file(f)
+
+
+def test_run_folder_has_the_asperities(tmp_path):
+    import meshio
+
+    scene = Scene(
+        fluid=Fluid(beta=1e5),
+        motion=Motion(gap=RampHold(0.2, -0.5, 1.0), velocity=0.0),
+        roughness=Roughness(0.1, 1.0),
+    )
+    femehl.solve(scene, t_end=1.0, mesh="coarse", dt=0.1, estimate=False, out=tmp_path / "run")
+    header = (tmp_path / "run" / "summary.csv").read_text().splitlines()[0].split(",")
+    assert {"asperity_load", "asperity_share", "asperity_friction"} <= set(header)
+    last = sorted((tmp_path / "run").glob("**/*.vtu"))[-1]
+    p_a = meshio.read(last).point_data["asperity_pressure"]
+    assert p_a.max() > 0 and np.all(p_a >= -1e-12)
+
+
+def test_si_roughness_is_greenwood_tripp_of_the_surface_statistics(tmp_path):
+    """[si] roughness keys: the stiffness against the reference's own formula, sigma over h_inf,
+    the aspect sqrt(h_inf/R) the friction needs."""
+    from femehl.problem.scenefile import load_scene_file
+
+    si = "R = 0.0095\nG = 0.4e6\neta = 0.1\nV_ss = 0.01\nh_inf = 1.8e-4\nh0 = 2e-5\nload = 0.5\n"
+    rough = (
+        "roughness_rms = 0.5e-6\nasperity_density = 2e10\nasperity_radius = 10e-6\nboundary_friction = 0.3\n"
+    )
+    f = tmp_path / "s.toml"
+    f.write_text("[si]\n" + si + rough)
+    scene, run = load_scene_file(f)
+    K = ref.gt_stiffness(0.0095, 0.4e6, 1.8e-4, 2e10, 10e-6, 0.5e-6)
+    assert scene.roughness.stiffness == pytest.approx(K, rel=1e-12)
+    assert scene.roughness.sigma == pytest.approx(0.5e-6 / 1.8e-4, rel=1e-12)
+    assert scene.roughness.aspect == pytest.approx(math.sqrt(1.8e-4 / 0.0095), rel=1e-12)
+    assert scene.roughness.friction == 0.3
+    assert scene.motion.F(0.0) == 0.0 and scene.motion.F(2.0) == pytest.approx(
+        0.5 / run["_dimensional"].force
+    )
+    f.write_text("[si]\n" + si + "roughness_rms = 0.5e-6\n")
+    with pytest.raises(SceneFileError, match="asperity_density"):
+        load_scene_file(f)
+
+
+LINE_STRIBECK = """
+[indenter]
+kind = "cylinder"
+[substrate]
+kind = "winkler"
+k = 1.0
+[fluid]
+beta = 200.0
+[roughness]
+sigma = 0.05
+stiffness = 2.0
+friction = 0.1
+aspect = 0.5
+[motion]
+velocity = 1.0
+[motion.load]
+kind = "table"
+times = [0.0, 1.0]
+values = [0.0, 0.5]
+[motion.gap]
+kind = "constant"
+value = 0.2
+[domain]
+L = 2.5
+[run]
+t_end = 20.0
+"""
+
+
+def test_stribeck_curve_of_a_line_contact(tmp_path):
+    """Four speeds over three decades (automatic mode, a local Dask cluster): from boundary to
+    full film, the asperities' share falling and the film rising with the speed, each point
+    the steady state of its own run; the table and the picture written."""
+    pytest.importorskip("distributed")
+    from femehl.studies.stribeck import stribeck
+
+    f = tmp_path / "line.toml"
+    f.write_text(LINE_STRIBECK)
+    curve = stribeck(f, (0.01, 10.0), 4, out=tmp_path / "out", workers=1, progress=False)
+    assert list(curve["status"]) == ["done"] * 4 and curve["steady"].all()
+    share, film = curve["asperity_share"].to_numpy(), curve["film_center"].to_numpy()
+    assert np.all(np.diff(share) < 0) and np.all(np.diff(film) > 0)
+    assert curve["regime"].iloc[0] == "boundary" and curve["regime"].iloc[-1] == "full film"
+    mu = curve["friction_coefficient"].to_numpy()
+    assert mu[0] == pytest.approx(0.1 * share[0], rel=0.1)  # boundary: mostly the asperities' mu_b
+    assert (tmp_path / "out" / "stribeck.csv").is_file() and (tmp_path / "out" / "stribeck.png").is_file()

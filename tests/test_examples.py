@@ -123,6 +123,22 @@ def check_rolling_traction(mod, tmp_path):
     assert (tmp_path / "rolling_traction.png").exists()
 
 
+def check_stribeck_curve(mod, tmp_path):
+    """Four speeds over four decades (a local Dask cluster): every point steady; from boundary
+    (the asperities carry all but 4e-5 of the load, so the friction coefficient is their
+    mu_b = 0.1: 0.10004 measured) through mixed to full film, the film rising and the
+    asperities' share falling with the speed; the friction coefficient's minimum inside."""
+    curve = mod.main(out=tmp_path, speeds=(1e-2, 1e2), num=4, workers=1)
+    assert list(curve["status"]) == ["done"] * 4 and curve["steady"].all()
+    share, film = curve["asperity_share"].to_numpy(), curve["film_center"].to_numpy()
+    assert np.all(np.diff(share) < 0) and np.all(np.diff(film) > 0)
+    assert list(curve["regime"])[0] == "boundary" and list(curve["regime"])[-1] == "full film"
+    mu = curve["friction_coefficient"].to_numpy()
+    assert mu[0] == pytest.approx(mod.MU_B, rel=1e-3)
+    assert mu.argmin() in (1, 2) and mu.min() < 0.5 * mod.MU_B
+    assert (tmp_path / "stribeck.png").is_file() and (tmp_path / "stribeck.csv").is_file()
+
+
 def check_ball_drop(mod, tmp_path):
     """One approach speed, dt = 0.004: the ball bounces (0 < e < 1; e = 0.765 at dt = 0.002,
     unchanged to 3 digits at 0.001), never touches the gel, and the energy budget closes to
@@ -146,6 +162,7 @@ CHECKS = {
     "ball_drop": check_ball_drop,
     "rubber_slider": check_rubber_slider,
     "rolling_traction": check_rolling_traction,
+    "stribeck_curve": check_stribeck_curve,
     "load_controlled": check_load_controlled,
     "ellipsoid_sliding": check_ellipsoid_sliding,
     "custom_shape": check_custom_shape,

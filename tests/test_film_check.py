@@ -52,6 +52,19 @@ def test_probed_node_film_is_the_exact_film_there():
         assert s.info["node_film_min"] == pytest.approx(s.film_center, rel=1e-12)
 
 
+def test_row_cache_keeps_the_rows_it_returns(monkeypatch):
+    """The probes' row cache evicts its oldest rows only after the step's rows are read: a
+    step probing more nodes than the cache's slack once lost a row it needed (KeyError; met
+    by a rough contact, whose many nodes below zero film are all probed)."""
+    from femehl.solver import stepper as module
+
+    monkeypatch.setattr(module, "_ROW_CACHE", 4)
+    st = femehl.make_stepper(femehl.presets.paper_sphere(), "fe", mesh="coarse")
+    first = st._node_rows(np.arange(4))
+    rows = st._node_rows(np.arange(6))  # 0..3 are the oldest, and needed
+    assert np.array_equal(rows[:4], first) and len(st._rows_cache) == 4
+
+
 @pytest.mark.parametrize(
     "scene, kw",
     [

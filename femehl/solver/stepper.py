@@ -298,9 +298,10 @@ class LaggedStepper:
             R = R.toarray() if sp.issparse(R) else np.asarray(R)
             for i, r in zip(new, R, strict=True):
                 cache[i] = r
-            while len(cache) > _ROW_CACHE:
-                cache.pop(next(iter(cache)))
-        return np.array([cache[i] for i in nodes])
+        rows = np.array([cache[i] for i in nodes])
+        while len(cache) > _ROW_CACHE:  # the oldest first (after reading: they may be this step's)
+            cache.pop(next(iter(cache)))
+        return rows
 
     def initial_state(self) -> State:
         mo = self.scene.motion

@@ -45,8 +45,11 @@ class StribeckError(FemehlError):
 
 
 def _raw(scene_file) -> dict:
+    """The scene's tables: ``scene_file`` itself if a dict, else the TOML file read."""
     from femehl.problem.scenefile import tomllib
 
+    if isinstance(scene_file, dict):
+        return scene_file
     path = pathlib.Path(scene_file)
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))
@@ -79,7 +82,8 @@ def plan_stribeck(scene_file, speeds, num: int = 26, out=None, run=None):
     else:
         name, values = "fluid.beta", [_base_beta(raw) / float(s) for s in factors]
     if out is None:
-        out = pathlib.Path(scene_file).with_suffix("").name + "-stribeck"
+        name_of = "scene" if isinstance(scene_file, dict) else pathlib.Path(scene_file).with_suffix("").name
+        out = name_of + "-stribeck"
     plan = plan_sweep(scene_file, {name: values}, run=run, out=out)
     return plan, name
 
@@ -183,9 +187,10 @@ def stribeck(
 
     Parameters
     ----------
-    scene_file : path
-        A TOML scene (SI or normalized units) whose run reaches a steady sliding state:
-        an imposed load and a constant speed after its start (``[run] t_end``).
+    scene_file : path or dict
+        A TOML scene (SI or normalized units), or its tables as a dict, whose run reaches
+        a steady sliding state: an imposed load and a constant speed after its start
+        (``[run] t_end``).
     speeds : (float, float)
         The lowest and highest speed: ``V_ss`` in m/s for an SI scene, else factors on
         the scene's speed.

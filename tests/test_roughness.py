@@ -210,3 +210,19 @@ def test_si_roughness_is_greenwood_tripp_of_the_surface_statistics(tmp_path):
     f.write_text("[si]\n" + si + "roughness_rms = 0.5e-6\n")
     with pytest.raises(SceneFileError, match="asperity_density"):
         load_scene_file(f)
+
+
+@pytest.mark.slow
+def test_free_indenter_comes_to_rest_on_the_asperities():
+    """A light free cylinder (m = 1e-3) pushed by F = 0.5 onto a rough Winkler foundation, no
+    sliding: it bounces, the film drains (beta = 1e4) and it settles where the dry rough
+    contact carries F (the pointwise reference, solved here for hc). Measured: hc -0.370379
+    against -0.370442 (200 elements, step_tol 1e-4; 98 s, 20,534 steps)."""
+    rough = Roughness(sigma=0.05, stiffness=2.0)
+    motion = Motion(gap=0.2, velocity=0.0, mass=1e-3, force=0.5)
+    scene = LineScene(k=1.0, L=2.5, beta=1e4, motion=motion, roughness=rough)
+    res = femehl.solve(scene, t_end=30.0, n_elements=200, step_tol=1e-4, estimate=False)
+    x = np.linspace(-2.5, 2.5, 5001)
+    hc = brentq(lambda h: np.trapezoid(_line_dry(rough, 1.0, h, x), x) - 0.5, -1.0, 0.0, xtol=1e-12)
+    assert res.hc[-1] == pytest.approx(hc, abs=5e-4)
+    assert res.asperity_share[-1] == pytest.approx(1.0, abs=1e-6)

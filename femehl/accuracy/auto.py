@@ -277,9 +277,13 @@ register_ladder(
 
 
 # ---- estimators --------------------------------------------------------------------------
-def _scale(name: str, q: np.ndarray) -> np.ndarray:
-    """The denominator of relative errors: |q|, floored at LOAD_FLOOR for the load."""
-    floor = LOAD_FLOOR if name == "load" else 0.0
+def _scale(name: str, q: np.ndarray, scene=None) -> np.ndarray:
+    """The denominator of relative errors: |q|, floored at LOAD_FLOOR for the load and, on
+    rough surfaces, at the roughness sigma for the films (which may then cross zero)."""
+    if name == "load":
+        floor = LOAD_FLOOR
+    else:
+        floor = float(getattr(getattr(scene, "roughness", None), "sigma", 0.0))
     return np.maximum(np.abs(q), floor)
 
 
@@ -295,7 +299,7 @@ def pair_error(fine: Result, coarse: Result, name: str, ratio: float) -> np.ndar
     scene = getattr(fine, "scene", None)
     if getattr(getattr(scene, "substrate", None), "instant", False):
         qc = _across_jumps(coarse, name, fine.t, qc, breakpoints_of(scene))
-    return np.abs(qf - qc) / (ratio**ORDER - 1.0) / _scale(name, qf)
+    return np.abs(qf - qc) / (ratio**ORDER - 1.0) / _scale(name, qf, scene)
 
 
 def _across_jumps(coarse, name, ts, qc, breaks) -> np.ndarray:
@@ -395,7 +399,7 @@ def one_run_estimate(run, full: Result, half: Result, ratio: float, order: int =
         qh = getattr(half, name)
         qf = np.array([full.value_at(name, t) for t in th])
         qr = np.interp(th, run.t, getattr(run, name))
-        e = np.abs(qf - qh) / (2.0**order - 1.0) / _scale(name, qr)
+        e = np.abs(qf - qh) / (2.0**order - 1.0) / _scale(name, qr, getattr(run, "scene", None))
         tpart = np.maximum.accumulate(np.interp(run.t, th, e))
         errors[name] = {"total": space + tpart, "space": space, "time": tpart}
     return Estimate(np.asarray(run.t, dtype=float), errors, "companion", ratio, tuple(levels))

@@ -1,0 +1,84 @@
+"""The Stribeck curve of a rough line contact over five decades of speed (issue 43, part 4).
+
+The scene of ``examples/stribeck_curve.py`` (a cylinder on a rough Winkler foundation under a
+constant load, Greenwood-Tripp asperities with mu_b = 0.1) at 26 speed factors from 1e-3 to
+1e2, each run in the automatic mode (no mesh, no dt) to its steady state, as
+``femehl stribeck`` runs them: a Dask sweep, two workers.  Writes ``stribeck.md`` (the curve,
+the regimes, the wall time and the cost per point) and ``stribeck.png`` here.
+
+Run::
+
+    python benchmarks/stribeck.py
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import shutil
+import sys
+import tempfile
+import time
+
+HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "examples"))
+
+from _machine import header  # noqa: E402
+
+SPEEDS, NUM, WORKERS = (1e-3, 1e2), 26, 2
+
+
+def main():
+    import stribeck_curve as example
+
+    from femehl.studies.stribeck import stribeck
+
+    out = pathlib.Path(tempfile.mkdtemp(prefix="femehl-stribeck-"))
+    t0 = time.perf_counter()
+    curve = stribeck(example.SCENE, SPEEDS, NUM, out=out, workers=WORKERS, progress=False)
+    wall = time.perf_counter() - t0
+    walls, cells = [], []
+    for case in sorted((out / "cases").iterdir()):
+        rec = json.loads((case / "case.json").read_text())
+        walls.append(rec.get("wall_s", float("nan")))
+        cells.append(rec.get("elements"))
+    shutil.copy(curve.attrs["png"], HERE / "stribeck.png")
+    regimes = {r: int((curve["regime"] == r).sum()) for r in ("boundary", "mixed", "full film")}
+    i = int(curve["friction_coefficient"].idxmin())
+    mu, steady = curve["friction_coefficient"], int(curve["steady"].sum())
+    statuses = dict(curve["status"].value_counts())
+    lines = [
+        "# The Stribeck curve of a rough line contact (`benchmarks/stribeck.py`)",
+        "",
+        header("stribeck.py"),
+        "",
+        f"The scene of `examples/stribeck_curve.py` at {NUM} speed factors from {SPEEDS[0]:g} to "
+        f"{SPEEDS[1]:g} (five decades), each in the automatic mode to its steady state at t = 20, "
+        f"as `femehl stribeck` runs them (a local Dask cluster, {WORKERS} workers).",
+        "",
+        f"- wall time {wall:.0f} s for {NUM} points; {sum(walls):.0f} s of runs, "
+        f"{sorted(walls)[len(walls) // 2]:.1f} s per point (median), {max(walls):.1f} s at most",
+        f"- statuses: {statuses}; steady at t_end: {steady} of {NUM}",
+        f"- regimes: {regimes}",
+        f"- friction coefficient: {mu.iloc[0]:.4f} at the lowest speed (mu_b = {example.MU_B}), minimum "
+        f"{mu.iloc[i]:.4f} at {curve['speed'].iloc[i]:.3g} ({curve['regime'].iloc[i]}), "
+        f"{mu.iloc[-1]:.4f} at the highest",
+        "",
+        "| speed | beta | friction coefficient | central film / sigma | asperities' share | regime "
+        "| steady |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for _, r in curve.iterrows():
+        lines.append(
+            f"| {r['speed']:.3g} | {r['beta']:.4g} | {r['friction_coefficient']:.5f} | "
+            f"{r['film_over_sigma']:.4f} | {r['asperity_share']:.4g} | {r['regime']} | {r['steady']} |"
+        )
+    lines += ["", "![The Stribeck curve](stribeck.png)", ""]
+    (HERE / "stribeck.md").write_text("\n".join(lines))
+    print("\n".join(lines[:12]))
+    shutil.rmtree(out, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -47,7 +47,7 @@ def main():
     regimes = {r: int((curve["regime"] == r).sum()) for r in ("boundary", "mixed", "full film")}
     i = int(curve["friction_coefficient"].idxmin())
     mu, steady = curve["friction_coefficient"], int(curve["steady"].sum())
-    statuses = dict(curve["status"].value_counts())
+    statuses = {k: int(v) for k, v in curve["status"].value_counts().items()}
     lines = [
         "# The Stribeck curve of a rough line contact (`benchmarks/stribeck.py`)",
         "",

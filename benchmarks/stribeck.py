@@ -74,7 +74,7 @@ def main():
             f"| {r['speed']:.3g} | {r['beta']:.4g} | {r['friction_coefficient']:.5f} | "
             f"{r['film_over_sigma']:.4f} | {r['asperity_share']:.4g} | {r['regime']} | {r['steady']} |"
         )
-    lines += ["", "![The Stribeck curve](stribeck.png)", ""]
+    lines += ["", "The picture: `stribeck.png` beside this table.", ""]
     (HERE / "stribeck.md").write_text("\n".join(lines))
     print("\n".join(lines[:12]))
     shutil.rmtree(out, ignore_errors=True)

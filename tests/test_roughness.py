@@ -235,3 +235,16 @@ def test_free_indenter_comes_to_rest_on_the_asperities():
     hc = brentq(lambda h: np.trapezoid(_line_dry(rough, 1.0, h, x), x) - 0.5, -1.0, 0.0, xtol=1e-12)
     assert res.hc[-1] == pytest.approx(hc, abs=5e-4)
     assert res.asperity_share[-1] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_a_runaway_step_is_stopped_below_the_limit():
+    """Through contact the film may fall below zero, but not past -10 sigma (the asperities
+    would press at 320 K): a fixed step of 2 time units on a rough line overshoots (measured:
+    the film reached -1.1e5 at t = 4) and raises femehl's error naming the fix, never a
+    run of nonsense to a singular system (what a coarse companion did before the limit)."""
+    from femehl.errors import FilmRuptureError
+
+    motion = Motion(gap=0.2, velocity=1.0, load=femehl.Table([0.0, 1.0], [0.0, 0.5]))
+    scene = LineScene(k=1.0, L=2.5, beta=8.0, motion=motion, roughness=Roughness(0.05, 2.0))
+    with pytest.raises(FilmRuptureError, match="below the rough surfaces' limit -0.5.*smaller dt"):
+        femehl.solve(scene, t_end=40.0, n_elements=100, dt=2.0, scheme="bdf2", estimate=False)

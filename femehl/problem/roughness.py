@@ -36,6 +36,10 @@ ROUGH_COLUMNS = ("asperity_load", "asperity_share", "asperity_friction")
 #: F_n(t) below this t is continued by its tangent (d < -38 sigma: far past any contact the
 #: model describes; D_{-n-1} overflows beyond it); above _T_ZERO it is below 1e-300
 _T_LOW, _T_ZERO = -38.0, 38.0
+#: the lowest mean separation a step may reach, in sigma: the asperities press with
+#: ``K F_{5/2}(-10) = 320 K`` there, far beyond any contact; below it a step overshot (a long
+#: step's runaway: the adaptive steps retry it shorter, fixed steps raise FilmRuptureError)
+FILM_LIMIT = 10.0
 #: the residual film where the surfaces are in full contact, over sigma (:func:`mean_gap`)
 RESIDUAL = 0.02
 #: where the asperities and the gap's roughness correction are negligible: F_{5/2}(8.5) < 1e-18
@@ -253,7 +257,7 @@ class AsperityContact(StepPart):
         Ui, Us = stepper.scene.motion.surface_speeds(state.t)
         info = dict(state.info)
         info.update(
-            film_may_close=True,  # the asperities carry the load where the film closes
+            film_limit=-FILM_LIMIT * self.rough.sigma,  # the asperities carry the load through contact
             film_error_floor=self.rough.sigma,  # the film's scale for the step error: d, at least sigma
             asperity_load=load_a,
             asperity_share=load_a / state.load if state.load != 0.0 else float("nan"),

@@ -263,7 +263,7 @@ def _floor_error(
     states = list(run.recent)
     ts, ds = _film_track(stepper, states, where)
     # where a part carries the load through contact (rough asperities) a film <= 0 is no end
-    t_zero = None if (last.info or {}).get("film_may_close") else _closing(ts, ds, run.film0)
+    t_zero = None if "film_limit" in (last.info or {}) else _closing(ts, ds, run.film0)
     what = f"a trial step of dt = {h:.3g} to t = {t_new:.6g} " + (
         f"failed ({fail.reason})" if fail is not None else f"has an error estimate {err:.3g} > tol"
     )

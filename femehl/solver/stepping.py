@@ -296,16 +296,26 @@ def film_floor(state: State) -> tuple:
 
 def film_positive(state: State) -> bool:
     """True when every film ``state`` knows of is finite and > 0 (the test of
-    :func:`_check_film`, without raising); only finite where a part carries the load
-    through contact (``state.info["film_may_close"]``: a rough surface's asperities)."""
+    :func:`_check_film`, without raising); where a part carries the load through contact,
+    above its limit instead (``state.info["film_limit"]``: a rough surface's -10 sigma)."""
     d = film_floor(state)[0]
-    return math.isfinite(d) and (d > 0.0 or bool(state.info.get("film_may_close")))
+    return math.isfinite(d) and d > state.info.get("film_limit", 0.0)
 
 
 def _check_film(state: State):
     if film_positive(state):
         return
     d, (x, y), where = film_floor(state)
+    if "film_limit" in state.info:  # through contact: only a runaway step gets there
+        raise FilmRuptureError(
+            f"the film reached {d:.3g} at t = {state.t:.6g}, at {where} (x, y) = ({x:.3g}, {y:.3g}), "
+            f"below the rough surfaces' limit {state.info['film_limit']:.3g} (their asperities would "
+            "press harder than any contact carries): the step overshot. Try a smaller dt or adaptive "
+            "steps (step_tol).",
+            t=state.t,
+            where=(x, y),
+            d_min=d,
+        )
     raise FilmRuptureError(
         f"film thickness reached {d:.3g} <= 0 at t = {state.t:.6g}, at {where} "
         f"(x, y) = ({x:.3g}, {y:.3g}): the fluid film ruptured (solid contact) or the "

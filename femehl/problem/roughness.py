@@ -225,22 +225,17 @@ class AsperityContact(StepPart):
         near = np.flatnonzero(d_star < _T_CONTACT * self.rough.sigma)
         if near.size == 0:
             return []
-        nf = d_star.size
-        b = np.zeros(nf)
-        b[near] = slope[near]
-        a = pa - slope * d_star
-        a[d_star >= _T_CONTACT * self.rough.sigma] = 0.0
-        # the asperities' share of the pressure: D acts on P - N (a + b d)
-        DN = sp.csr_matrix(D @ self.N)
-        F = -(DN @ sp.diags(b))
-        rhs = DN @ a
-        # the film's content h_T = Phi* d + r
-        c = np.zeros(nf)
-        c[near] = 1.0 - Phi[near]
-        r = hT_star - Phi * d_star
-        F = F - G @ sp.diags(c)
-        rhs = rhs - G @ np.where(c > 0.0, r, 0.0)
-        return [(sp.csr_matrix(F), np.asarray(rhs).ravel())]
+        # on the elements near contact only (columns ``near`` of the film operators)
+        b, a = slope[near], pa[near] - slope[near] * d_star[near]
+        c, r = 1.0 - Phi[near], hT_star[near] - Phi[near] * d_star[near]
+        DN, Gn = sp.csr_matrix(D @ self.N[:, near]), sp.csr_matrix(G)[:, near]
+        # the asperities' share of the pressure: D acts on P - N (a + b d); the film's
+        # content h_T = Phi* d + r
+        Fn = -(DN @ sp.diags(b)) - Gn @ sp.diags(c)
+        rhs = DN @ a - Gn @ r
+        k = near.size
+        pick = sp.csr_matrix((np.ones(k), (np.arange(k), near)), shape=(k, d_star.size))  # to all columns
+        return [(sp.csr_matrix(Fn @ pick), np.asarray(rhs).ravel())]
 
     def finish(self, stepper, solved, new):
         """The asperity pressure the step solved for (its linearization at the new film)."""

@@ -172,6 +172,24 @@ class StepOperator:
         return StepOperator(D=(R @ self.D + E).tocsr(), films=films, C=self.C, key=self.key)
 
 
+class LazyProduct:
+    """A dense ``F C`` formed the first time it is read, then kept.
+
+    A film operator of one step only (a rough film's, :mod:`femehl.problem.roughness`):
+    a Krylov step applies ``A z = D z + G (C z)`` and reads ``F C`` only when it forms
+    or refreshes its preconditioner (``matrix()``, ``columns()``), so most steps never
+    form it.  Read by row blocks or columns, as a dense array is.
+    """
+
+    def __init__(self, make, shape):
+        self._make, self.shape, self._value = make, shape, None
+
+    def __getitem__(self, key):
+        if self._value is None:
+            self._value, self._make = self._make(), None
+        return self._value[key]
+
+
 class _RowMasked:
     """A dense ``F C`` read with some rows zeroed (``matrix()`` reads row blocks)."""
 

@@ -33,15 +33,40 @@ __all__ = [
 
 #: name -> cavitation model class (``Fluid(cavitation=name)``)
 CAVITATION_MODELS = Registry("cavitation condition", key="name")
-#: JFO: the adaptive steps' estimate leaves out the cells within this many rings of a node
-#: that switched set (:meth:`JFOCavitation.settled_cells`).  On the paper case with JFO at
+#: JFO and Reynolds: the adaptive steps' estimate leaves out the cells within this many rings
+#: of a node that switched set (``settled_cells``).  On the paper case with JFO at
 #: tol 1e-2, meshes adapted to its first run (5,900 cells): one ring (the switched node's
 #: own cells) stalled at the step floor at t = 1.84, two went on to t = 2.57, three finished
 #: (342 steps, 19 rejected, 31 s); on the fitted level 0.707, 911 steps (257 rejected)
-#: with one ring, 379 (39) with two (2026-12-05)
+#: with one ring, 379 (39) with two (2026-12-05); Reynolds on a rough PDMS ball at 1e-3 m/s
+#: (coarse mesh, step_tol 1e-3) stalled at t = 1.09 without it, ran to t = 3 in 1,704 steps
+#: with it (the set flickers where the asperities touch: there the film's flux has no sign)
 SWITCH_RINGS = 3
 #: class decorator adding a cavitation model to :data:`CAVITATION_MODELS` under ``cls.name``
 register_cavitation = CAVITATION_MODELS.register
+
+
+def _settled_cells(disc, states):
+    """The cells more than :data:`SWITCH_RINGS` rings of cells away from every node that
+    changed between full and cavitated over ``states`` (None: all of them), for the
+    adaptive steps' error estimate: where the lagged set switches a node on the cavity's
+    edge, the film around it jumps whatever the step."""
+    sets = [np.asarray(s.own["p_aux"]) < 0.0 for s in states if s.own.get("p_aux") is not None]
+    P = getattr(disc, "P", None)
+    if len(sets) < 2 or P is None:
+        return None
+    changed = np.zeros(sets[0].size, dtype=bool)
+    for later in sets[1:]:
+        changed |= later != sets[0]
+    if not changed.any():
+        return None
+    nodes = np.zeros(P.shape[1])
+    nodes[disc.free_index] = changed
+    near = np.asarray(P @ nodes).ravel() > 0.0
+    for _ in range(SWITCH_RINGS - 1):  # the nodes of those cells, then their cells
+        ring = (np.asarray(P.T @ near.astype(float)).ravel() > 0.0).astype(float)
+        near = np.asarray(P @ ring).ravel() > 0.0
+    return ~near
 
 
 class _Model:
@@ -179,6 +204,7 @@ class ReynoldsCavitation(_Model):
 
     name = "reynolds"
     columns = ("cavitated_area", "full_film_source")
+    settled_cells = staticmethod(_settled_cells)
     note = (
         "Reynolds (Swift-Stieber): p >= 0, the cavitated set lagged one step; mass is "
         "conserved at rupture, not where the film reforms"
@@ -197,7 +223,7 @@ class ReynoldsCavitation(_Model):
         unmasked system): the next step's set is ``{y < 0}``; area, extremes and the mass
         source go to ``info``."""
         op, rhs, p, fixed, scale = solved.op, solved.rhs, solved.p, solved.aux, solved.scale
-        y = np.array(p, dtype=float)
+        y = np.array(stepper.film_pressure(new, p), dtype=float)
         info = dict(new.info)
         lam = np.zeros(0)
         if fixed.size:  # the residual of the held rows only
@@ -207,7 +233,7 @@ class ReynoldsCavitation(_Model):
         info["cavitated_area"] = float(g[y < 0.0].sum())
         free = np.ones(p.size, dtype=bool)
         free[fixed] = False
-        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
+        info["p_negative_min"] = float(min(0.0, y[free].min())) if free.any() else 0.0
         info["full_film_source"] = _plane_factor(stepper.disc) * float(lam.sum())
         _mark_unsettled(solved, info)
         return dataclasses.replace(new, info=info).with_own(p_aux=y)
@@ -398,28 +424,7 @@ class JFOCavitation(_Model):
         info["theta_min"] = 1.0
         return info
 
-    @staticmethod
-    def settled_cells(disc, states):
-        """The cells more than :data:`SWITCH_RINGS` rings of cells away from every node that
-        changed between full and cavitated over ``states`` (None: all of them), for the
-        adaptive steps' error estimate: where the lagged set switches a node on the cavity's
-        edge, the film around it jumps whatever the step."""
-        sets = [np.asarray(s.own["p_aux"]) < 0.0 for s in states if s.own.get("p_aux") is not None]
-        P = getattr(disc, "P", None)
-        if len(sets) < 2 or P is None:
-            return None
-        changed = np.zeros(sets[0].size, dtype=bool)
-        for later in sets[1:]:
-            changed |= later != sets[0]
-        if not changed.any():
-            return None
-        nodes = np.zeros(P.shape[1])
-        nodes[disc.free_index] = changed
-        near = np.asarray(P @ nodes).ravel() > 0.0
-        for _ in range(SWITCH_RINGS - 1):  # the nodes of those cells, then their cells
-            ring = (np.asarray(P.T @ near.astype(float)).ravel() > 0.0).astype(float)
-            near = np.asarray(P @ ring).ravel() > 0.0
-        return ~near
+    settled_cells = staticmethod(_settled_cells)
 
     def prepare(self, stepper, op, rhs_list, state, ctx):
         """The switched system: ``p`` or the gas ``v`` at each node, the set from ``state``."""
@@ -477,7 +482,7 @@ class JFOCavitation(_Model):
         info["net_outflow"] = f * (total - time_part)
         info["mass_imbalance"] = abs(total) / size if size > 0.0 else 0.0
         free = ~S
-        info["p_negative_min"] = float(min(0.0, p[free].min())) if free.any() else 0.0
+        info["p_negative_min"] = float(min(0.0, y[free].min())) if free.any() else 0.0
         theta = 1.0
         if S.any():  # 1 - v / dbar, dbar the mean gap of the node's cell (its row's content)
             theta = float(np.min(1.0 - v[S] / dbar[S]))

@@ -147,11 +147,12 @@ class Roughness:
         return mean_gap(d, self.sigma)
 
     def check_scene(self, scene) -> None:
-        if getattr(scene, "cavitation", None) is not None:
+        cavitation = getattr(scene, "cavitation", None)
+        if cavitation not in (None, "reynolds"):
             raise SceneError(
-                f"a rough scene with cavitation = {scene.cavitation!r} is not supported yet: the "
-                "cavitation condition would hold the total pressure, not the film's. Leave cavitation "
-                "out (full Sommerfeld) or the roughness out."
+                f"a rough scene takes cavitation = 'reynolds' (the film's pressure >= 0, the "
+                f"asperities' apart), not {cavitation!r}: its content and clipping are not written "
+                "for a mean gap. Use cavitation = 'reynolds', or leave it out (full Sommerfeld)."
             )
 
     @staticmethod
@@ -219,23 +220,47 @@ class AsperityContact(StepPart):
         stepper.solver.rtol_scale = film_rtol_scale(hT, state.w)  # the film the solve must resolve
         return dataclasses.replace(ctx, d=hT, d_lag=hT_star, history=history)
 
+    def _near(self):
+        """The film points near contact and the asperity pressure's ``a``, ``b`` there."""
+        d_star, _, _, pa, slope = self._lin
+        near = np.flatnonzero(d_star < _T_CONTACT * self.rough.sigma)
+        b = slope[near]
+        return near, pa[near] - b * d_star[near], b
+
+    def _to_all(self, F, near):
+        """``F`` on the columns ``near`` as a film operator on every film point."""
+        k = near.size
+        pick = sp.csr_matrix((np.ones(k), (np.arange(k), near)), shape=(k, self._lin[0].size))
+        return sp.csr_matrix(F @ pick)
+
     def operator(self, stepper, ctx, D, G):
         """``[(F, rhs)]``: film operators on ``d^{k+1}`` and right-hand sides the roughness adds."""
-        d_star, hT_star, Phi, pa, slope = self._lin
-        near = np.flatnonzero(d_star < _T_CONTACT * self.rough.sigma)
+        _, hT_star, Phi, _, _ = self._lin
+        near, a, b = self._near()
         if near.size == 0:
             return []
         # on the elements near contact only (columns ``near`` of the film operators)
-        b, a = slope[near], pa[near] - slope[near] * d_star[near]
-        c, r = 1.0 - Phi[near], hT_star[near] - Phi[near] * d_star[near]
+        c, r = 1.0 - Phi[near], hT_star[near] - Phi[near] * self._lin[0][near]
         DN, Gn = sp.csr_matrix(D @ self.N[:, near]), sp.csr_matrix(G)[:, near]
         # the asperities' share of the pressure: D acts on P - N (a + b d); the film's
         # content h_T = Phi* d + r
         Fn = -(DN @ sp.diags(b)) - Gn @ sp.diags(c)
         rhs = DN @ a - Gn @ r
-        k = near.size
-        pick = sp.csr_matrix((np.ones(k), (np.arange(k), near)), shape=(k, d_star.size))  # to all columns
-        return [(sp.csr_matrix(Fn @ pick), np.asarray(rhs).ravel())]
+        return [(self._to_all(Fn, near), np.asarray(rhs).ravel())]
+
+    def held_rows(self, stepper, ctx, held):
+        """What the rows ``held`` at ``p = 0`` (a cavitated node) add: they hold the film's
+        pressure, ``P - N (a + b d) = 0``: the film operator ``-N diag(b)`` and the
+        right-hand side ``N a`` on those rows."""
+        near, a, b = self._near()
+        n = self.N.shape[0]
+        rows = sp.csr_matrix((np.ones(held.size), (held, held)), shape=(n, n))
+        Nn = rows @ self.N[:, near]
+        return self._to_all(-(Nn @ sp.diags(b)), near), np.asarray(Nn @ a).ravel()
+
+    def solid_pressure(self, state):
+        """The asperities' share of ``state``'s pressure unknowns (free nodes)."""
+        return state.own["p_asperity"]
 
     def finish(self, stepper, solved, new):
         """The asperity pressure the step solved for (its linearization at the new film)."""

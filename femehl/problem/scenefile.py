@@ -269,7 +269,8 @@ def _si_scene(raw, path):
     if clash:
         raise SceneFileError(
             f"{path}: [si] replaces {sorted(clash)}; give one or the other "
-            "(only [indenter] may accompany [si], in metres)."
+            "(only [indenter] may accompany [si], in metres; a cavitation condition is "
+            '[si] cavitation = "reynolds", the slide-to-roll ratio [si] slide_roll).'
         )
     si = raw["si"]
     if not isinstance(si, dict):

@@ -11,6 +11,7 @@ refresh rules and tolerances: docs/design.md section 3.2 (and sections 9-10).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -53,12 +54,15 @@ class StepOperator:
         Compliance: ``d = h + C p`` on the film points.
     key : float
         A number that changes when the matrix changes a lot (``a0/dt``): LU refresh.
+    held : ndarray of int or None
+        The rows :meth:`with_fixed` replaced (the cavitated nodes), None if none.
     """
 
     D: sp.spmatrix
     films: list
     C: object
     key: float
+    held: np.ndarray | None = None
 
     @property
     def dense(self) -> bool:
@@ -169,7 +173,11 @@ class StepOperator:
             (c, (R @ F).tocsr(), (R @ FC).tocsr() if sp.issparse(FC) else _RowMasked(FC, keep))
             for c, F, FC in self.films
         ]
-        return StepOperator(D=(R @ self.D + E).tocsr(), films=films, C=self.C, key=self.key)
+        return StepOperator(D=(R @ self.D + E).tocsr(), films=films, C=self.C, key=self.key, held=fixed)
+
+    def with_film(self, c, F, FC) -> StepOperator:
+        """The operator with one more film operator ``c F`` (and its product ``F C``)."""
+        return dataclasses.replace(self, films=[*self.films, (c, F, FC)])
 
 
 class LazyProduct:

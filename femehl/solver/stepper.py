@@ -127,10 +127,10 @@ class LaggedStepper:
         rough = getattr(scene, "roughness", None)
         self.roughness = None if rough is None else rough.part(disc)
         #: what takes part in the step beside the terms (femehl.solver.parts): the motion's
-        #: unknown hc, then the substrate's memory, the fluid's cavitation condition and the
-        #: surfaces' roughness
+        #: unknown hc, then the substrate's memory, the surfaces' roughness and the fluid's
+        #: cavitation condition (after the roughness: it holds the film's share of the pressure)
         self.gap = gap_control(scene.motion)
-        self.parts = [part for part in (self.memory, self.cavitation, self.roughness) if part is not None]
+        self.parts = [part for part in (self.memory, self.roughness, self.cavitation) if part is not None]
         from femehl.output.table import extra_columns
         from femehl.solver.energetics import TRIBOLOGY_COLUMNS
 
@@ -336,6 +336,8 @@ class LaggedStepper:
         for part in self.parts:  # rows held, or unknowns added
             system, rhs_list, aux = part.rows(self, system, rhs_list, state, ctx)
             auxes.append(aux)
+        if getattr(system, "held", None) is not None:
+            system, rhs_list = self._held(system, rhs_list, ctx, shape, scale)
         its0 = self.solver.info.get("krylov_iterations", 0)
         solutions = self.solver.solve(system, rhs_list, t_new)
         x, Cp, hc, own = self.gap.close(self, solutions, state, t_new, dt, ctx)
@@ -361,6 +363,25 @@ class LaggedStepper:
             new = part.finish(self, solved, new)
         self._budget(new)  # from the parts' own variables too (a cavity's gas)
         return new
+
+    def _held(self, system, rhs_list, ctx, shape, scale):
+        """A held row says ``p = 0`` of the film's pressure: the parts that carry a share of
+        the pressure (``held_rows``: a rough surface's asperities) add theirs to it."""
+        for part in self.parts:
+            if hasattr(part, "held_rows"):
+                F, r = part.held_rows(self, ctx, system.held)  # film operator on d^{k+1}, rhs
+                system = system.with_film(scale, F, self._step_product(F))
+                extra = self.gap.rhs(self, r, F, shape, ctx.t_new)
+                rhs_list = [b + e for b, e in zip(rhs_list, extra, strict=True)]
+        return system, rhs_list
+
+    def film_pressure(self, state, p):
+        """The film's share of the pressure unknowns ``p`` of ``state``: ``p`` less what the
+        parts carry (``solid_pressure``: a rough surface's asperities)."""
+        for part in self.parts:
+            if hasattr(part, "solid_pressure"):
+                p = p - part.solid_pressure(state)
+        return p
 
     def _context(self, state: State, t_new: float, dt: float) -> StepContext:
         """The terms' lagged context: the scheme's coefficients, the lagged film and pressure."""

@@ -298,12 +298,15 @@ def _floor_error(
     return exc
 
 
-def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf):
+def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf, squeeze=math.inf):
     dt_max = t_span / 10.0 if dt_max is None else check_positive("dt_max", dt_max)
     dt_max = min(dt_max, limit)  # the substrate's model resolves no longer step (its memory)
     # the floor stays 100 times below the first step (a long run at a small tol starts
-    # with steps ~0.05 tol, below 1e-6 of its span)
-    dt_min = min(1e-6 * t_span, 5e-4 * tol, dt_max) if dt_min is None else check_positive("dt_min", dt_min)
+    # with steps ~0.05 tol, below 1e-6 of its span), and below the film's squeeze time
+    if dt_min is None:
+        dt_min = min(1e-6 * t_span, 5e-4 * tol, dt_max, squeeze)
+    else:
+        dt_min = check_positive("dt_min", dt_min)
     if dt0 is None:
         dt0 = max(dt_min, min(dt_max, 0.05 * tol))
     dt0 = check_positive("dt0", dt0)
@@ -312,6 +315,19 @@ def _limits(t_span, tol, dt0, dt_min, dt_max, limit=math.inf):
     if not dt_min <= dt0 <= dt_max:
         raise SceneError(f"need dt_min <= dt0 <= dt_max, got {dt_min:g}, {dt0:g}, {dt_max:g}.")
     return dt0, dt_min, dt_max
+
+
+def _squeeze_time(scene, state: State) -> float:
+    """``1 / (beta d0^2)``: the time in which a unit pressure squeezes the initial thinnest
+    film ``d0`` by its own size (``beta div(d^3 grad p) = dd/dt`` over a unit length).  A
+    slow scene (``beta`` large: a soft rough ball at 1e-7 m/s, beta = 3e8, 2.8e-7) falls
+    to the asperities that fast when its load comes on, far below the usual floor
+    (``5e-4 tol``); for the paper's beta = 200 it is 0.5, and the floor is the usual one."""
+    beta = getattr(getattr(scene, "fluid", None), "beta", None)
+    d0 = film_floor(state)[0]
+    if not beta or not np.isfinite(d0) or d0 <= 0.0:
+        return math.inf
+    return 1.0 / (float(beta) * d0 * d0)
 
 
 # ---- the step policy ----------------------------------------------------------------------
@@ -329,7 +345,8 @@ class AdaptiveSteps:
         First step and the step after each breakpoint; default ``0.05 tol``.
     dt_min, dt_max : float, optional
         Step floor and ceiling; default ``min(1e-6 span, 5e-4 tol)`` (100 times below
-        the default first step) and ``0.1`` times the run's span.  The ceiling is at most
+        the default first step; lower for a slow film, below its squeeze time
+        ``1 / (beta d0^2)``) and ``0.1`` times the run's span.  The ceiling is at most
         the substrate's ``step_limit`` (:func:`femehl.elastic.base.step_limit`: the
         largest step a viscoelastic memory resolves).
     safety : float, default: 0.9
@@ -367,7 +384,9 @@ class AdaptiveSteps:
             raise SceneError(f"t_end = {t_end:g} is not after the start t = {state.t:g}.")
         scene = getattr(stepper, "scene", None)
         limit = step_limit(getattr(scene, "substrate", None), scene, getattr(stepper, "disc", None), t_end)
-        dt0, dt_min, dt_max = _limits(t_end - state.t, self.tol, self.dt0, self.dt_min, self.dt_max, limit)
+        dt0, dt_min, dt_max = _limits(
+            t_end - state.t, self.tol, self.dt0, self.dt_min, self.dt_max, limit, _squeeze_time(scene, state)
+        )
         eps = 1e-12 * max(1.0, abs(t_end))
         stops = sorted({b for b in breakpoints_of(scene) if state.t + eps < b < t_end - eps} | {t_end})
         state = _tag(state, 0.0, math.nan if start is None else state.info.get("error_estimate", math.nan), 0)

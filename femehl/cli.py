@@ -532,7 +532,9 @@ class _SummaryFile:
 
         with open(self.path, newline="") as fh:
             rows = list(csv.reader(fh))
-        head, body = rows[0], np.array(rows[1:], dtype=float).reshape(-1, len(rows[0]))
+        # an empty cell is a figure the run could not give (an estimate without its companion)
+        values = [[float(v) if v != "" else np.nan for v in row] for row in rows[1:]]
+        head, body = rows[0], np.array(values, dtype=float).reshape(-1, len(rows[0]))
         return {c: body[:, i] for i, c in enumerate(head)}
 
 

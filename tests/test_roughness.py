@@ -9,6 +9,7 @@ Checked against independent solutions: the Greenwood-Tripp function by quadratur
 from __future__ import annotations
 
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -227,17 +228,15 @@ def test_run_folder_has_the_asperities(tmp_path):
 
 
 def test_si_roughness_is_greenwood_tripp_of_the_surface_statistics(tmp_path):
-    """[si] roughness keys: the stiffness against the reference's own formula, sigma over h_inf,
-    the aspect sqrt(h_inf/R) the friction needs."""
+    """[si] roughness keys (examples/pdms_ball.toml): the stiffness against the reference's own
+    formula, sigma over h_inf, the aspect sqrt(h_inf/R) the friction needs; the example runs
+    from its file (its [run] settings, the first steps)."""
+    from femehl.cli import main as cli_main
     from femehl.problem.scenefile import load_scene_file
 
-    si = "R = 0.0095\nG = 0.4e6\neta = 0.1\nV_ss = 0.01\nh_inf = 1.8e-4\nh0 = 2e-5\nload = 0.5\n"
-    rough = (
-        "roughness_rms = 0.5e-6\nasperity_density = 2e10\nasperity_radius = 10e-6\nboundary_friction = 0.3\n"
-    )
-    f = tmp_path / "s.toml"
-    f.write_text("[si]\n" + si + rough)
-    scene, run = load_scene_file(f)
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "pdms_ball.toml"
+    scene, run = load_scene_file(example)
+    assert scene.cavitation == "reynolds" and run["mesh"] == "coarse"
     K = ref.gt_stiffness(0.0095, 0.4e6, 1.8e-4, 2e10, 10e-6, 0.5e-6)
     assert scene.roughness.stiffness == pytest.approx(K, rel=1e-12)
     assert scene.roughness.sigma == pytest.approx(0.5e-6 / 1.8e-4, rel=1e-12)
@@ -246,6 +245,10 @@ def test_si_roughness_is_greenwood_tripp_of_the_surface_statistics(tmp_path):
     assert scene.motion.F(0.0) == 0.0 and scene.motion.F(2.0) == pytest.approx(
         0.5 / run["_dimensional"].force
     )
+    rc = cli_main(["run", str(example), "--t-end", "0.05", "--out", str(tmp_path / "run"), "--quiet"])
+    assert rc == 0 and (tmp_path / "run" / "summary_si.csv").is_file()
+    si = "R = 0.0095\nG = 0.4e6\neta = 0.1\nV_ss = 0.01\nh_inf = 1.8e-4\nh0 = 2e-5\nload = 0.5\n"
+    f = tmp_path / "s.toml"
     f.write_text("[si]\n" + si + "roughness_rms = 0.5e-6\n")
     with pytest.raises(SceneFileError, match="asperity_density"):
         load_scene_file(f)

@@ -526,16 +526,9 @@ class _SummaryFile:
         self.path = pathlib.Path(folder) / "summary.csv"
 
     def summary(self) -> dict:
-        import csv
+        from femehl.output.table import read_summary
 
-        import numpy as np
-
-        with open(self.path, newline="") as fh:
-            rows = list(csv.reader(fh))
-        # an empty cell is a figure the run could not give (an estimate without its companion)
-        values = [[float(v) if v != "" else np.nan for v in row] for row in rows[1:]]
-        head, body = rows[0], np.array(values, dtype=float).reshape(-1, len(rows[0]))
-        return {c: body[:, i] for i, c in enumerate(head)}
+        return read_summary(self.path)
 
 
 def _write_si_summary(dim, result, out):

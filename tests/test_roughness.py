@@ -8,6 +8,7 @@ Checked against independent solutions: the Greenwood-Tripp function by quadratur
 
 from __future__ import annotations
 
+import functools
 import math
 import pathlib
 
@@ -135,6 +136,7 @@ def test_thick_film_is_the_smooth_run(cavitation):
         assert area[0] > 0.1 and area[1] == pytest.approx(area[0], rel=1e-12)
 
 
+@functools.cache  # the same steady state serves the budget and the cavitation test
 def _mixed_steady(srr, n=400, T=60.0, cavitation=None):
     rough = Roughness(sigma=0.05, stiffness=2.0, friction=0.1, aspect=0.5)
     motion = Motion(gap=0.6, velocity=0.05, slide_roll=srr, load=RampHold(0.0, 0.5, 1.0))

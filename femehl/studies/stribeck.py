@@ -147,7 +147,7 @@ def stribeck_curve(plan, table, name: str, raw: dict):
             row["regime"] = "full film"
         else:
             row["regime"] = "mixed"
-        row["steady"] = bool(ok and _steady(part))
+        row["steady"] = bool(ok and _steady(_history(plan.out / "cases" / case.key, part)))
         if dim is not None:
             row["film_center_m"] = row["film_center"] * dim.height
             row["film_min_m"] = row["film_min"] * dim.height
@@ -157,15 +157,27 @@ def stribeck_curve(plan, table, name: str, raw: dict):
     return pd.DataFrame(rows).sort_values("speed", ignore_index=True)
 
 
-def _steady(part) -> bool:
+def _history(folder, part):
+    """``(t, friction)`` of every step from the case's ``summary.csv`` (the sweep's table
+    has its stored times only, which may be a few), else of ``part``."""
+    from femehl.output.table import read_summary
+
+    try:
+        table = read_summary(pathlib.Path(folder) / "summary.csv")
+        return table["t"], table["friction"]
+    except (FemehlError, KeyError):
+        return part["t"].to_numpy(float), part["friction"].to_numpy(float)
+
+
+def _steady(history) -> bool:
     """The friction changed by less than :data:`STEADY_CHANGE` over the last fifth of the run."""
-    t, f = part["t"].to_numpy(float), part["friction"].to_numpy(float)
+    t, f = (np.asarray(a, dtype=float) for a in history)
     if t.size < 2 or not np.all(np.isfinite(f[-1:])):
         return False
     i = np.flatnonzero(t <= 0.8 * t[-1])
     if i.size == 0:
         return False
-    before = f[i[-1]]  # the last stored state at least a fifth of the run before the end
+    before = f[i[-1]]  # the last state at least a fifth of the run before the end
     return bool(abs(f[-1] - before) <= STEADY_CHANGE * max(abs(f[-1]), 1e-300))
 
 

@@ -137,12 +137,12 @@ def test_thick_film_is_the_smooth_run(cavitation):
 
 
 @functools.cache  # the same steady state serves the budget and the cavitation test
-def _mixed_steady(srr, n=400, T=60.0, cavitation=None):
+def _mixed_steady(srr, n=400, T=60.0, cavitation=None, tol=1e-5):
     rough = Roughness(sigma=0.05, stiffness=2.0, friction=0.1, aspect=0.5)
     motion = Motion(gap=0.6, velocity=0.05, slide_roll=srr, load=RampHold(0.0, 0.5, 1.0))
     scene = LineScene(k=1.0, L=2.5, beta=10.0, motion=motion, roughness=rough, cavitation=cavitation)
     stepper = femehl.make_stepper(scene, n_elements=n, scheme="bdf2")
-    state = list(femehl.march(stepper, T, AdaptiveSteps(tol=1e-5, dt0=1e-3)))[-1]
+    state = list(femehl.march(stepper, T, AdaptiveSteps(tol=tol, dt0=1e-3)))[-1]
     speeds = scene.motion.surface_speeds(T)
     e = sliding_energetics(stepper.disc, state, scene.fluid.beta, speeds, **stepper.roughness.budget(state))
     return state, speeds, e, stepper
@@ -167,7 +167,8 @@ def test_cavitated_rows_hold_the_film_pressure():
     cavitated set, where the asperities carry the whole pressure; without the film's
     tension behind the contact the asperities carry less of the load than in full
     Sommerfeld (0.66 against 0.74 here)."""
-    state, _, _, stepper = _mixed_steady(2.0, cavitation="reynolds")
+    # tol 1e-4: the same end state as 1e-5 (tests/test_rough_line_reference.py), at a fifth of the cost
+    state, _, _, stepper = _mixed_steady(2.0, cavitation="reynolds", tol=1e-4)
     full = _mixed_steady(2.0)[0]
     free = np.flatnonzero(np.asarray(state.own["p_aux"]) >= 0.0)
     held = np.flatnonzero(np.asarray(state.own["p_aux"]) < 0.0)

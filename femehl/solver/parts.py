@@ -25,7 +25,11 @@ class StepPart:
     returns the terms' lagged context changed (a rough film's mean gap), and
     ``operator(stepper, ctx, D, G)`` returns ``[(F, rhs), ...]``, sparse film operators on
     the step's ``d^{k+1}`` (coefficient 1) and right-hand sides added to the terms' (``D``
-    their matrix, ``G`` their film operators summed).
+    their matrix, ``G`` their film operators summed).  A part that carries a share of the
+    pressure unknowns has two more: ``solid_pressure(state)``, that share (the film's
+    pressure is the rest: :meth:`LaggedStepper.film_pressure`), and
+    ``held_rows(stepper, ctx, held)``, ``(F, rhs)`` that the rows ``held`` at ``p = 0`` (a
+    cavitated node) add so that they hold the film's pressure.
     """
 
     def initial(self, stepper, state):

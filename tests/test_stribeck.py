@@ -30,6 +30,15 @@ def test_the_speeds_of_an_si_scene_are_its_sliding_speed(tmp_path):
     assert [c.params[name] for c in plan.cases] == pytest.approx([1e-3, 1e-2, 1e-1], rel=1e-12)
 
 
+def test_the_cases_keep_no_field_series_unless_asked(tmp_path):
+    plan, _ = plan_stribeck(SI, (1e-3, 1e-1), 2, out=tmp_path / "a")
+    assert all(c.options.get("store_every") == 0 for c in plan.cases)
+    plan, _ = plan_stribeck(
+        {**SI, "run": {"t_end": 3.0, "store_every": 5}}, (1e-3, 1e-1), 2, out=tmp_path / "b"
+    )
+    assert all(c.options.get("store_every") == 5 for c in plan.cases)
+
+
 def test_the_speeds_of_a_normalized_scene_divide_its_beta(tmp_path):
     scene = pathlib.Path(__file__).resolve().parents[1] / "examples" / "cylinder_winkler.toml"
     beta = tomllib.loads(scene.read_text())["fluid"]["beta"]

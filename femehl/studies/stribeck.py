@@ -63,7 +63,9 @@ def plan_stribeck(scene_file, speeds, num: int = 26, out=None, run=None):
     """The sweep of ``scene_file`` over ``num`` speeds from ``speeds[0]`` to ``speeds[1]``.
 
     Returns ``(plan, speed_name)``: the :class:`femehl.studies.sweeps.SweepPlan` and the
-    swept parameter (``"si.V_ss"`` or ``"fluid.beta"``).
+    swept parameter (``"si.V_ss"`` or ``"fluid.beta"``).  The cases keep no field series
+    (``store_every = 0``: a slow case's would be 60-70 MB) unless ``run`` or the scene's
+    ``[run]`` says ``store_every``.
     """
     from femehl.studies.sweeps import plan_sweep
 
@@ -84,6 +86,9 @@ def plan_stribeck(scene_file, speeds, num: int = 26, out=None, run=None):
     if out is None:
         name_of = "scene" if isinstance(scene_file, dict) else pathlib.Path(scene_file).with_suffix("").name
         out = name_of + "-stribeck"
+    stated = {**(raw.get("run") or {}), **(run or {})}
+    if "store_every" not in stated:  # a curve needs each case's summary, not its field series
+        run = {**(run or {}), "store_every": 0}
     plan = plan_sweep(scene_file, {name: values}, run=run, out=out)
     return plan, name
 

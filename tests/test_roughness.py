@@ -284,3 +284,26 @@ def test_a_runaway_step_is_stopped_below_the_limit():
     scene = LineScene(k=1.0, L=2.5, beta=8.0, motion=motion, roughness=Roughness(0.05, 2.0))
     with pytest.raises(FilmRuptureError, match="below the rough surfaces' limit -0.5.*smaller dt"):
         femehl.solve(scene, t_end=40.0, n_elements=100, dt=2.0, scheme="bdf2", estimate=False)
+
+
+def test_a_slow_scene_starts_with_steps_below_its_squeeze_time():
+    """The rough PDMS ball at 1.8e-6 m/s (beta = 1.6e7): the usual first step 0.05 tol = 5e-4
+    takes the film, its coefficient lagged at d0 = 40 sigma, through the asperities in one
+    step (to -9 sigma, measured); the default first step is the squeeze time 1/(beta d0^2)
+    (5e-6), over which the film falls by a small part of itself."""
+    from femehl.problem.scenefile import scene_from_mapping, tomllib
+    from femehl.solver.adaptive import _limits, _squeeze_time
+
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "pdms_ball.toml"
+    raw = tomllib.loads(example.read_text())
+    raw["si"]["V_ss"] = 1.78e-6
+    scene = scene_from_mapping(raw, "pdms_ball.toml")[0]
+    stepper = femehl.make_stepper(scene, mesh="coarse", scheme="euler")
+    s0 = stepper.initial_state()
+    tau = _squeeze_time(scene, s0)
+    assert tau == pytest.approx(1.0 / (scene.fluid.beta * s0.film_min**2), rel=1e-12)
+    dt0, dt_min, _ = _limits(8.0, 1e-2, None, None, None, squeeze=tau)
+    assert dt0 == tau and dt_min == pytest.approx(0.01 * tau)
+    sigma = scene.roughness.sigma
+    assert stepper.step(s0, 5e-4, 5e-4).film_min < -5 * sigma  # the old first step overshoots
+    assert stepper.step(s0, dt0, dt0).film_min > 0.9 * s0.film_min

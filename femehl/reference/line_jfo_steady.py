@@ -381,6 +381,76 @@ class SteadyJFO:
                 out[m] = pb.V * (r.q - d) / (pb.beta * d**3)
         return out
 
+    def friction(self, sliding=None, asperity_friction=0.0, epsrel=1e-10):
+        """The friction force along x on the indenter per unit length, and its parts, by adaptive
+        quadrature over the regions (split at the profile's kinks).
+
+        The forces of :func:`femehl.solver.energetics.sliding_energetics`, written for the exact
+        solution::
+
+            shear_couette    = S/(6 beta) int c / h_T dx
+            shear_poiseuille = int (h_T / 2) p' dx
+            pressure_drag    = int P s'(x) dx      (= -int (hc + s) P' dx, P = 0 at x = +-L)
+
+        ``c`` the liquid the Couette shear acts on: the JFO filling ``theta`` (1 in a Reynolds
+        or full-Sommerfeld film, whose cavity's content the model does not say), and with a
+        roughness the wetted fraction squared ``Phi(d/sigma)^2`` (the shear on the wetted part
+        through its gap ``h_T / Phi``).  ``friction`` adds
+        ``asperity_friction * asperity_load sign(S)``.
+
+        Parameters
+        ----------
+        sliding : float, optional
+            ``S = U_s - U_i``, the sliding speed; default ``V`` (pure sliding of the substrate).
+        asperity_friction : float, default: 0
+            The asperities' friction coefficient in femehl's force unit
+            (``Roughness.friction / Roughness.aspect``).
+        epsrel : float
+            The quadrature's relative tolerance per interval.
+
+        Returns
+        -------
+        dict
+            ``friction``, ``shear_couette``, ``shear_poiseuille``, ``pressure_drag``,
+            ``asperity_friction``.
+        """
+        pb = self._problem
+        S = pb.V if sliding is None else float(sliding)
+        rough = self.roughness
+        eps = 1e-6
+
+        def slope(x):  # s'(x), central differences (error ~1e-12 s''')
+            return (float(pb._s(np.array([x + eps]))[0]) - float(pb._s(np.array([x - eps]))[0])) / (2 * eps)
+
+        def couette(x):
+            xa = np.array([x])
+            c = float(self.fraction(xa)[0]) if self.model == "jfo" else 1.0
+            if rough is not None:
+                c *= float(ndtr(self.film(xa)[0] / rough.sigma)) ** 2
+            return c / float(self.mean_gap(xa)[0])
+
+        def poiseuille(x):
+            xa = np.array([x])
+            return 0.5 * float(self.mean_gap(xa)[0]) * float(self.pressure_gradient(xa)[0])
+
+        def drag(x):
+            return float(self.total_pressure(np.array([x]))[0]) * slope(x)
+
+        cuts = sorted({-pb.L, pb.L, *pb.kinks.tolist(), *(e for r in self.regions for e in (r.a, r.b))})
+        pieces = [(a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True) if b > a]
+
+        def integral(f):
+            return sum(quad(f, a, b, epsrel=epsrel, epsabs=0.0, limit=200)[0] for a, b in pieces)
+
+        out = {
+            "shear_couette": S / (6.0 * pb.beta) * integral(couette),
+            "shear_poiseuille": integral(poiseuille),
+            "pressure_drag": integral(drag),
+            "asperity_friction": float(asperity_friction) * float(np.sign(S)) * self.asperity_load,
+        }
+        out["friction"] = sum(out.values())
+        return out
+
 
 # --------------------------------------------------------------------------
 # the problem and its full-region integrator

@@ -40,9 +40,12 @@ How the FE run is made steady: the load's transient takes a few hundred time uni
 2e-3 off (hc 5e-5, five times its 400-element error), at t = 117 1e-5, at t = 220 1e-7.  Runs
 go to T = 400, and the states at t ~ 300 and 400 agree to 1e-11.  ``dt_max = 10``: with the
 default T/10 the steps grow to it once the run is steady, and at steps of 40 and more the
-lagged BDF2 step oscillates with a growing amplitude (full Sommerfeld, 400 elements: the share
-+-8e-6 about its limit at t = 550 with steps of 40, 1.4e-4 off at t = 800 with steps of 80;
-steps of 20 stay steady to 1e-7).  ``tol = 1e-4``: a steady state of the scheme is its steady
+lagged step, one iteration of the steady problem's fixed point, oscillates with a growing
+amplitude (full Sommerfeld, 400 elements, before the adaptive steps caught it: the share
++-8e-6 about its limit at t = 550 with steps of 40, 1.4e-4 off at t = 800 with steps of 80).
+The adaptive steps now catch that mode and keep the steps below it
+(:func:`test_the_lag_mode_is_caught_on_long_steady_steps`); ``dt_max = 10`` keeps these runs
+short of it.  ``tol = 1e-4``: a steady state of the scheme is its steady
 weak form whatever the steps (docs/design.md section 4), so only the path depends on tol; the
 final states at tol 1e-4 and 1e-5 agree to 2e-14 in hc and 5e-13 in the share (400 elements;
 Reynolds 5 s against 29 s).
@@ -50,6 +53,7 @@ Reynolds 5 s against 29 s).
 
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
@@ -311,3 +315,25 @@ def test_fe_converges_to_the_reference_at_second_order(cavitation):
         assert np.all(orders > 1.7), (name, e, orders)
     for name in ("share", "film_min"):
         assert abs(errs[2][name]) < TOL[cavitation][name] / 2
+
+
+def test_the_lag_mode_is_caught_on_long_steady_steps(caplog, runs):
+    """With the default ceiling (T/10 = 80) the steady run's steps grow to where the lagged
+    step diverges in sign-alternating increments (the steady problem's fixed point: share
+    1.4e-4 off at t = 800 before, with Milne's estimate within tol).  The adaptive steps see
+    the period-two mode (successive film increments opposite and not decaying), retry the step
+    at a quarter of it and keep every later step there: measured, caught at steps of 80 then
+    20, the last steps 5; the state at t = 800 is steady to 1e-15 and is the dt_max = 10
+    run's at T = 400 (hc 1.4e-15 apart, share 7e-14)."""
+    stepper = femehl.make_stepper(scene(None), n_elements=400, scheme="bdf2")
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        states = list(femehl.march(stepper, 2 * T_END, AdaptiveSteps(tol=STEP_TOL, dt0=1e-3)))
+    caught = [r.getMessage() for r in caplog.records if "oscillates from step to step" in r.getMessage()]
+    assert caught and "steps of 80" in caught[0]
+    last = states[-1]
+    earlier = [s for s in states if s.t <= 2 * T_END - 100.0][-1]
+    assert max(b.t - a.t for a, b in zip(states[-20:-1], states[-19:], strict=True)) <= 20.0
+    assert abs(last.hc - earlier.hc) < 1e-12
+    steady = runs[None][2]
+    assert abs(last.hc - steady.hc) < 1e-11
+    assert abs(last.info["asperity_share"] - steady.info["asperity_share"]) < 1e-11

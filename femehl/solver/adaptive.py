@@ -11,6 +11,7 @@ Every yielded State's ``info`` gets ``dt``, ``error_estimate`` (nan where none w
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import logging
 import math
 from collections import deque
@@ -37,6 +38,16 @@ THIN_FILM = 1e-4
 LOAD_FLOOR = 0.1
 #: the local error is per unit time for steps longer than UNIT_STEP, per UNIT_STEP below
 UNIT_STEP = 0.01
+#: the lag's period-two mode (:func:`_lag_mode`): a film increment with a cosine below
+#: -LAG_COSINE to the one before and LAG_GROWTH times larger, or two such reversals in a row
+#: with the last at least LAG_RATIO of the one before, above LAG_FLOOR of the step's
+#: tolerance; the step is then retried, and every later one kept, below LAG_SHARE of it (a
+#: quarter: the time companion's steps, twice the run's, stay below half of it)
+LAG_COSINE = 0.5
+LAG_GROWTH = 1.5
+LAG_RATIO = 0.9
+LAG_FLOOR = 1e-3
+LAG_SHARE = 0.25
 #: keyword arguments of :class:`AdaptiveSteps` that tune the controller
 CONTROLS = ("dt0", "dt_min", "dt_max", "safety")
 
@@ -471,6 +482,17 @@ class AdaptiveSteps:
         if not ctl.accepts(err):
             self._refuse(err, p, t_new, h)
             return
+        if run.pending is None and h > dt_min * (1.0 + 1e-9) and _lag_mode(run, trial, h, ctl.tol):
+            self._dt_max = max(dt_min, LAG_SHARE * h)
+            logger.info(
+                "femehl: at t = %.4g the film oscillates from step to step at steps of %.3g (the "
+                "lagged coefficients' fixed point diverges): steps are kept below %.3g from here on",
+                t_new,
+                h,
+                self._dt_max,
+            )
+            _reject(run, 1, self._dt_max, "the lag's period-two mode", t_new, h)
+            return
         if run.pending is not None:
             yield from _emit(run, run.pending, run.pending_rejected, err)
         yield from _emit(run, trial, run.rejected, err)
@@ -520,6 +542,37 @@ class AdaptiveSteps:
             run.origin = run.levels[0].t
             run.dt = min(run.dt, self._dt0)
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
+
+
+def _lag_mode(run: _Run, trial: State, h: float, tol: float) -> bool:
+    """True when the film's last increments (levels and trial) are the lag's period-two mode:
+    the last opposite to the one before (cosine below ``-LAG_COSINE``) and growing by
+    ``LAG_GROWTH``, or the last two reversals in a row with the last increment at least
+    ``LAG_RATIO`` of the one before; never round-off (the last increment's largest relative
+    change above ``LAG_FLOOR`` of what the tolerance allows a step).  With its coefficients
+    lagged a step is one iteration of the steady problem's fixed point, which diverges in
+    sign-alternating increments on steps too long for the time derivative to damp it;
+    Milne's estimate, per unit time, passes those steps.  A physical turning point reverses
+    the increments once, and not into a larger one."""
+    if len(run.levels) < 2:
+        return False
+    d = np.asarray(trial.d, dtype=float)
+    scale = np.maximum(d, (trial.info or {}).get("film_error_floor", 0.0))
+    films = [np.asarray(s.d, dtype=float) for s in run.levels[-3:]] + [d]
+    steps = [(b - a) / scale for a, b in itertools.pairwise(films)]
+    keep = None if run.settled is None else run.settled([*run.levels, trial])
+    if keep is not None and keep.any():
+        steps = [x[keep] for x in steps]
+    norms = [float(np.linalg.norm(x)) for x in steps]
+    if not min(norms) > 0.0 or np.max(np.abs(steps[-1])) <= LAG_FLOOR * tol * max(h, UNIT_STEP):
+        return False
+    cosines = [
+        float(a @ b) / (na * nb) for a, b, na, nb in zip(steps, steps[1:], norms, norms[1:], strict=False)
+    ]
+    growth = norms[-1] / norms[-2]
+    if cosines[-1] < -LAG_COSINE and growth >= LAG_GROWTH:
+        return True
+    return len(cosines) > 1 and max(cosines[-2:]) < -LAG_COSINE and growth >= LAG_RATIO
 
 
 def _failure(trial: State | None, exc: Exception | None) -> _Failure | None:

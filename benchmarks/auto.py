@@ -594,7 +594,10 @@ def main(argv=None) -> None:
         type=float,
         help="femehl's own time budget of the automatic runs (max_wall), seconds; give a --cap above it",
     )
-    ap.add_argument("--redo", help="comma-separated scene names whose automatic runs at --tol are run again")
+    ap.add_argument(
+        "--redo",
+        help="comma-separated scene names whose automatic runs at --tol are run again (others are kept)",
+    )
     args = ap.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(json.loads(args.worker))))
@@ -621,7 +624,7 @@ def main(argv=None) -> None:
                 for m in HAND_LADDER.get(n, ())
                 for dt in HAND_DT
             ]
-        if not args.resume:
+        if not args.resume and not args.redo:  # --redo keeps every other record
             records = []
             RUNS.write_text("")
         if args.redo:  # the named scenes' automatic runs at the tolerances asked for, not others

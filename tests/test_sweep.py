@@ -114,6 +114,25 @@ def test_a_killed_worker_is_survived(tmp_path):
     assert st[200.0] == "done" and st[50.0] == "done"  # ... and Dask ran the case again
 
 
+def test_a_script_without_the_main_guard_gets_femehls_error(tmp_path):
+    """A script that starts a sweep at import: each Dask worker, a new Python process that
+    imports the script, starts it again and dies, and the cluster raised distributed's bare
+    "Nanny failed to start".  femehl's error names the guard (measured: 3 s)."""
+    import subprocess
+
+    script = tmp_path / "sweep_script.py"
+    script.write_text(
+        "from femehl.studies import sweeps\n"
+        f"sweeps.sweep(None, cases=[{{'fluid.beta': 50.0}}], run={RUN!r}, out={str(tmp_path / 'out')!r}, "
+        "workers=1, progress=False)\n"
+    )
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env)
+    assert out.returncode != 0
+    last = out.stderr.strip().splitlines()[-1]
+    assert last.startswith("femehl.errors.SolverError") and 'if __name__ == "__main__":' in last
+
+
 def test_another_sweep_in_the_same_folder_is_refused(swept, tmp_path):
     table, out, cases = swept
     with pytest.raises(femehl.errors.OutputError, match="holds another sweep"):

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from femehl.errors import FemehlError, OutputError, SceneError
+from femehl.errors import FemehlError, OutputError, SceneError, SolverError
 
 __all__ = [
     "MAX_CASES",
@@ -716,13 +716,21 @@ def _client(scheduler, workers, memory_limit):
             ) from None
     check_cluster(scheduler, workers, memory_limit)
     n = workers if workers is not None else (os.cpu_count() or 1)
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        memory_limit=memory_limit if memory_limit is not None else "auto",
-        dashboard_address=":0",  # a free port: two sweeps on one machine do not collide
-    )
+    try:
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            memory_limit=memory_limit if memory_limit is not None else "auto",
+            dashboard_address=":0",  # a free port: two sweeps on one machine do not collide
+        )
+    except RuntimeError as exc:  # a worker process that could not start ("Nanny failed to start")
+        raise SolverError(
+            f"the local Dask cluster's worker processes ({n}) did not start ({exc}). In a script, "
+            'start the sweep under `if __name__ == "__main__":` (each worker is a new Python '
+            "process that imports the script, and would start the sweep again); or give the "
+            "address of a Dask scheduler already running (scheduler=...)."
+        ) from None
     return Client(cluster), cluster
 
 

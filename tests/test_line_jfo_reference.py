@@ -179,6 +179,22 @@ def test_rigid_cylinder_is_the_closed_form():
         assert s.p.min() < -0.5 * pe.max()  # full Sommerfeld: the antisymmetric exit lobe
 
 
+def test_friction_of_the_rigid_cylinder_is_martins():
+    """:meth:`SteadyJFO.friction` (quadrature over the shot solution) against Martin's closed
+    form (:mod:`femehl.reference.rigid_cylinder`) of the rigid cylinder under the Reynolds
+    condition: measured Couette to 2e-16, Poiseuille 2.6e-14, pressure drag 7.7e-12 (the
+    shot pressure's own error); tolerance 1e-10."""
+    from femehl.reference.rigid_cylinder import martin_cylinder
+
+    for hc, beta, V in ((0.05, 10.0, 1.0), (0.01, 1.0, 0.5)):
+        f = steady_reynolds(None, hc, V, beta, math.inf, 2.0).friction()
+        m = martin_cylinder(hc, beta, V, 2.0)
+        assert f["shear_couette"] == pytest.approx(V * m.couette_integral / (6.0 * beta), rel=1e-10)
+        assert f["shear_poiseuille"] == pytest.approx(m.poiseuille, rel=1e-10)
+        assert f["pressure_drag"] == pytest.approx(m.pressure_drag, rel=1e-10)
+        assert f["friction"] == pytest.approx(f["shear_couette"] + m.poiseuille + m.pressure_drag, rel=1e-10)
+
+
 def test_stiff_winkler_cylinder_is_the_rigid_one_plus_its_first_correction():
     """k -> inf with hc > 0: p = p0 + p1/k + ..., q = q0 + q1/k + ... with the closed-form rigid p0
     and q0.  The O(1/k) equation ``beta (h^3 p1' + 3 h^2 p0 p0') = V (q1 - p0)`` and p1(+-L) = 0

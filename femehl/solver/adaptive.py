@@ -38,13 +38,12 @@ THIN_FILM = 1e-4
 LOAD_FLOOR = 0.1
 #: the local error is per unit time for steps longer than UNIT_STEP, per UNIT_STEP below
 UNIT_STEP = 0.01
-#: the lag's period-two mode (:func:`_lag_mode`): a film increment with a cosine below
-#: -LAG_COSINE to the one before and LAG_GROWTH times larger, or two such reversals in a row
-#: with the last at least LAG_RATIO of the one before, above LAG_FLOOR of the step's
-#: tolerance; the step is then retried, and every later one kept, below LAG_SHARE of it (a
-#: quarter: the time companion's steps, twice the run's, stay below half of it)
+#: the lag's period-two mode (:func:`_lag_mode`): three film increments in a row, each with a
+#: cosine below -LAG_COSINE to the one before, the last at least LAG_RATIO of the one before
+#: and above LAG_FLOOR of the step's tolerance; the step is then retried, and every later one
+#: kept, below LAG_SHARE of it (a quarter: the time companion's steps, twice the run's, stay
+#: below half of it)
 LAG_COSINE = 0.5
-LAG_GROWTH = 1.5
 LAG_RATIO = 0.9
 LAG_FLOOR = 1e-3
 LAG_SHARE = 0.25
@@ -545,16 +544,16 @@ class AdaptiveSteps:
 
 
 def _lag_mode(run: _Run, trial: State, h: float, tol: float) -> bool:
-    """True when the film's last increments (levels and trial) are the lag's period-two mode:
-    the last opposite to the one before (cosine below ``-LAG_COSINE``) and growing by
-    ``LAG_GROWTH``, or the last two reversals in a row with the last increment at least
-    ``LAG_RATIO`` of the one before; never round-off (the last increment's largest relative
+    """True when the film's last three increments (two levels and the trial) are the lag's
+    period-two mode: each opposite to the one before (cosines below ``-LAG_COSINE``), the
+    last at least ``LAG_RATIO`` of the one before, and not round-off (its largest relative
     change above ``LAG_FLOOR`` of what the tolerance allows a step).  With its coefficients
     lagged a step is one iteration of the steady problem's fixed point, which diverges in
     sign-alternating increments on steps too long for the time derivative to damp it;
     Milne's estimate, per unit time, passes those steps.  A physical turning point reverses
-    the increments once, and not into a larger one."""
-    if len(run.levels) < 2:
+    the increments once; a pattern that reverses every step is no evolution the steps
+    resolve, whatever made it."""
+    if len(run.levels) < 3:
         return False
     d = np.asarray(trial.d, dtype=float)
     scale = np.maximum(d, (trial.info or {}).get("film_error_floor", 0.0))
@@ -564,15 +563,14 @@ def _lag_mode(run: _Run, trial: State, h: float, tol: float) -> bool:
     if keep is not None and keep.any():
         steps = [x[keep] for x in steps]
     norms = [float(np.linalg.norm(x)) for x in steps]
-    if not min(norms) > 0.0 or np.max(np.abs(steps[-1])) <= LAG_FLOOR * tol * max(h, UNIT_STEP):
+    if not min(norms) > 0.0 or norms[2] < LAG_RATIO * norms[1]:
         return False
-    cosines = [
-        float(a @ b) / (na * nb) for a, b, na, nb in zip(steps, steps[1:], norms, norms[1:], strict=False)
-    ]
-    growth = norms[-1] / norms[-2]
-    if cosines[-1] < -LAG_COSINE and growth >= LAG_GROWTH:
-        return True
-    return len(cosines) > 1 and max(cosines[-2:]) < -LAG_COSINE and growth >= LAG_RATIO
+    if np.max(np.abs(steps[2])) <= LAG_FLOOR * tol * max(h, UNIT_STEP):
+        return False
+    return all(
+        float(a @ b) < -LAG_COSINE * na * nb
+        for a, b, na, nb in zip(steps, steps[1:], norms, norms[1:], strict=False)
+    )
 
 
 def _failure(trial: State | None, exc: Exception | None) -> _Failure | None:

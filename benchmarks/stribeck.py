@@ -13,7 +13,6 @@ Run::
 
 from __future__ import annotations
 
-import json
 import pathlib
 import shutil
 import sys
@@ -25,6 +24,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 
 from _machine import header  # noqa: E402
+from _stribeck_report import case_walls, summary  # noqa: E402
 
 SPEEDS, NUM, WORKERS = (1e-3, 1e2), 26, 2
 
@@ -38,16 +38,8 @@ def main():
     t0 = time.perf_counter()
     curve = stribeck(example.SCENE, SPEEDS, NUM, out=out, workers=WORKERS, progress=False)
     wall = time.perf_counter() - t0
-    walls, cells = [], []
-    for case in sorted((out / "cases").iterdir()):
-        rec = json.loads((case / "case.json").read_text())
-        walls.append(rec.get("wall_s", float("nan")))
-        cells.append(rec.get("elements"))
+    walls = list(case_walls(out, "fluid.beta").values())
     shutil.copy(curve.attrs["png"], HERE / "stribeck.png")
-    regimes = {r: int((curve["regime"] == r).sum()) for r in ("boundary", "mixed", "full film")}
-    i = int(curve["friction_coefficient"].idxmin())
-    mu, steady = curve["friction_coefficient"], int(curve["steady"].sum())
-    statuses = {k: int(v) for k, v in curve["status"].value_counts().items()}
     lines = [
         "# The Stribeck curve of a rough line contact (`benchmarks/stribeck.py`)",
         "",
@@ -57,13 +49,7 @@ def main():
         f"{SPEEDS[1]:g} (five decades), each in the automatic mode to its steady state at t = 20, "
         f"as `femehl stribeck` runs them (a local Dask cluster, {WORKERS} workers).",
         "",
-        f"- wall time {wall:.0f} s for {NUM} points; {sum(walls):.0f} s of runs, "
-        f"{sorted(walls)[len(walls) // 2]:.1f} s per point (median), {max(walls):.1f} s at most",
-        f"- statuses: {statuses}; steady at t_end: {steady} of {NUM}",
-        f"- regimes: {regimes}",
-        f"- friction coefficient: {mu.iloc[0]:.4f} at the lowest speed (mu_b = {example.MU_B}), minimum "
-        f"{mu.iloc[i]:.4f} at {curve['speed'].iloc[i]:.3g} ({curve['regime'].iloc[i]}), "
-        f"{mu.iloc[-1]:.4f} at the highest",
+        *summary(curve, wall, walls, example.MU_B),
         "",
         "| speed | beta | friction coefficient | central film / sigma | asperities' share | regime "
         "| steady |",

@@ -15,7 +15,6 @@ Run::
 
 from __future__ import annotations
 
-import json
 import pathlib
 import shutil
 import sys
@@ -26,17 +25,12 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _machine import header  # noqa: E402
+from _stribeck_report import case_walls, summary  # noqa: E402
 
 SCENE = HERE.parent / "examples" / "pdms_ball.toml"
 SPEEDS, NUM, WORKERS = (1e-8, 1.0), 33, 2
 CHECK = (1e-5, 1e-1, 3)  # 1e-5, 1e-3, 1e-1 m/s on the medium mesh
 QUANTITIES = ("friction_coefficient", "film_center_m", "asperity_share")
-
-
-def _walls(out) -> dict:
-    """Each case's wall time by its speed."""
-    recs = [json.loads((c / "case.json").read_text()) for c in sorted((out / "cases").iterdir())]
-    return {float(r["params"]["si.V_ss"]): r.get("wall_s", float("nan")) for r in recs}
 
 
 def main():
@@ -46,7 +40,7 @@ def main():
     t0 = time.perf_counter()
     curve = stribeck(SCENE, SPEEDS, NUM, out=out / "coarse", workers=WORKERS, progress=False)
     wall = time.perf_counter() - t0
-    wall_of = _walls(out / "coarse")
+    wall_of = case_walls(out / "coarse", "si.V_ss")
     walls = list(wall_of.values())
     shutil.copy(curve.attrs["png"], HERE / "stribeck_pdms.png")
 
@@ -62,10 +56,6 @@ def main():
     coarse_at = curve[[bool(np.isclose(v, fine["speed"], rtol=1e-9).any()) for v in curve["speed"]]]
     assert len(coarse_at) == n, "the check's speeds must be on the curve"
 
-    regimes = {r: int((curve["regime"] == r).sum()) for r in ("boundary", "mixed", "full film")}
-    mu = curve["friction_coefficient"]
-    i = int(mu.idxmin())
-    statuses = {k: int(v) for k, v in curve["status"].value_counts().items()}
     lines = [
         "# The Stribeck curve of a rough PDMS ball on glass (`benchmarks/stribeck_pdms.py`)",
         "",
@@ -77,14 +67,7 @@ def main():
         f"(seven contact radii of sliding), as `femehl stribeck examples/pdms_ball.toml --speeds "
         f"{SPEEDS[0]:g} {SPEEDS[1]:g} --num {NUM}` runs them (a local Dask cluster, {WORKERS} workers).",
         "",
-        f"- wall time {wall:.0f} s for {NUM} points; {sum(walls):.0f} s of runs (each with its "
-        f"companion estimate), {sorted(walls)[len(walls) // 2]:.0f} s per point (median), "
-        f"{max(walls):.0f} s at most (the lowest speeds cost most)",
-        f"- statuses: {statuses}; steady at t_end: {int(curve['steady'].sum())} of {NUM}",
-        f"- regimes: {regimes}",
-        f"- friction coefficient: {mu.iloc[0]:.4f} at the lowest speed (mu_b = 0.3), minimum "
-        f"{mu.iloc[i]:.4f} at {curve['speed'].iloc[i]:.3g} m/s ({curve['regime'].iloc[i]}), "
-        f"{mu.iloc[-1]:.4f} at the highest",
+        *summary(curve, wall, walls, 0.3, " m/s"),
         "",
         "| V_ss [m/s] | Hersey eta U_e R / W | friction coefficient | central film [um] | film / sigma "
         "| asperities' share | regime | steady | wall [s] |",

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import json
+import pathlib
+import shutil
+
+HERE = pathlib.Path(__file__).resolve().parent
 
 
 def case_walls(out, name: str) -> dict:
@@ -28,3 +32,12 @@ def summary(curve, wall: float, walls, mu_b: float, unit: str = "") -> list[str]
         f"{mu.iloc[i]:.4f} at {curve['speed'].iloc[i]:.3g}{unit} ({curve['regime'].iloc[i]}), "
         f"{mu.iloc[-1]:.4f} at the highest",
     ]
+
+
+def finish(lines: list[str], name: str, out) -> None:
+    """Point to the picture ``name.png``, write ``name.md`` here, print its head, and remove
+    the sweep's temporary folder ``out``."""
+    lines = [*lines, "", f"The picture: `{name}.png` beside this table.", ""]
+    (HERE / f"{name}.md").write_text("\n".join(lines))
+    print("\n".join(lines[:14]))
+    shutil.rmtree(out, ignore_errors=True)

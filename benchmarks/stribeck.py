@@ -24,7 +24,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 
 from _machine import header  # noqa: E402
-from _stribeck_report import case_walls, summary  # noqa: E402
+from _stribeck_report import case_walls, finish, summary  # noqa: E402
 
 SPEEDS, NUM, WORKERS = (1e-3, 1e2), 26, 2
 
@@ -60,10 +60,7 @@ def main():
             f"| {r['speed']:.3g} | {r['beta']:.4g} | {r['friction_coefficient']:.5f} | "
             f"{r['film_over_sigma']:.4f} | {r['asperity_share']:.4g} | {r['regime']} | {r['steady']} |"
         )
-    lines += ["", "The picture: `stribeck.png` beside this table.", ""]
-    (HERE / "stribeck.md").write_text("\n".join(lines))
-    print("\n".join(lines[:12]))
-    shutil.rmtree(out, ignore_errors=True)
+    finish(lines, "stribeck", out)
 
 
 if __name__ == "__main__":

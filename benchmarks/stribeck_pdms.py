@@ -25,7 +25,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _machine import header  # noqa: E402
-from _stribeck_report import case_walls, summary  # noqa: E402
+from _stribeck_report import case_walls, finish, summary  # noqa: E402
 
 SCENE = HERE.parent / "examples" / "pdms_ball.toml"
 SPEEDS, NUM, WORKERS = (1e-8, 1.0), 33, 2
@@ -93,10 +93,7 @@ def main():
             diff = abs(a - b) / max(abs(b), 1e-300) if q != "asperity_share" else abs(a - b)
             unit = "relative" if q != "asperity_share" else "absolute"
             lines.append(f"| {c['speed']:.3g} | {q} | {a:.5g} | {b:.5g} | {diff:.2g} ({unit}) |")
-    lines += ["", "The picture: `stribeck_pdms.png` beside this table.", ""]
-    (HERE / "stribeck_pdms.md").write_text("\n".join(lines))
-    print("\n".join(lines[:14]))
-    shutil.rmtree(out, ignore_errors=True)
+    finish(lines, "stribeck_pdms", out)
 
 
 if __name__ == "__main__":

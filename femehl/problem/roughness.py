@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.special import gamma, ndtr, pbdv
 
-from femehl.errors import SceneError
+from femehl.errors import SceneError, SolverError
 from femehl.solver.parts import StepPart
 from femehl.validation import check_positive
 
@@ -40,6 +40,10 @@ _T_LOW, _T_ZERO = -38.0, 38.0
 #: ``K F_{5/2}(-10) = 320 K`` there, far beyond any contact; below it a step overshot (a long
 #: step's runaway: the adaptive steps retry it shorter, fixed steps raise FilmRuptureError)
 FILM_LIMIT = 10.0
+#: the start's static asperity contact (:meth:`AsperityContact.initial`): Newton steps at
+#: most, and the largest pressure change, relative to the largest pressure, it converged at
+#: (the linear solves' own residual is 1e-8 relative)
+_STATIC_ITERATIONS, _STATIC_RTOL = 60, 1e-8
 #: the residual film where the surfaces are in full contact, over sigma (:func:`mean_gap`)
 RESIDUAL = 0.02
 #: where the asperities and the gap's roughness correction are negligible: F_{5/2}(8.5) < 1e-18
@@ -206,10 +210,7 @@ class AsperityContact(StepPart):
     def context(self, stepper, state, ctx):
         """The terms' context in mean gaps; the linearization point kept for :meth:`operator`."""
         rough = self.rough
-        d_star = np.asarray(ctx.d_lag, dtype=float)
-        hT_star, Phi, _ = rough.mean_gap(d_star)
-        pa, slope = rough.pressure(d_star)
-        self._lin = (d_star, hT_star, Phi, pa, slope)
+        hT_star = self._linearize(ctx.d_lag)[1]
         hT = rough.mean_gap(state.d)[0]
         if ctx.a2 != 0.0 and state.d_prev is not None:
             history = ctx.a1 * hT - ctx.a2 * rough.mean_gap(state.d_prev)[0]
@@ -219,6 +220,14 @@ class AsperityContact(StepPart):
 
         stepper.solver.rtol_scale = film_rtol_scale(hT, state.w)  # the film the solve must resolve
         return dataclasses.replace(ctx, d=hT, d_lag=hT_star, history=history)
+
+    def _linearize(self, d_star):
+        """Keep the linearization point ``(d*, h_T*, Phi*, p_a*, p_a'*)`` and return it."""
+        d_star = np.asarray(d_star, dtype=float)
+        hT_star, Phi, _ = self.rough.mean_gap(d_star)
+        pa, slope = self.rough.pressure(d_star)
+        self._lin = (d_star, hT_star, Phi, pa, slope)
+        return self._lin
 
     def _near(self):
         """The film points near contact and the asperity pressure's ``a``, ``b`` there."""
@@ -269,7 +278,37 @@ class AsperityContact(StepPart):
         return self._report(stepper, new, pa_new)
 
     def initial(self, stepper, state):
-        return self._report(stepper, state, self.rough.pressure(state.d)[0])
+        """The start at rest: the film at ambient pressure and the substrate in equilibrium
+        with the asperities, ``P = N p_a(h + C P)`` (the static rough contact, by Newton's
+        method from ``P = 0``; nothing to do where no asperity touches).  A substrate with a
+        memory starts undeformed, as a smooth one does."""
+        pa = self.rough.pressure(state.d)[0]
+        if np.any(pa > 0.0) and stepper.memory is None:
+            state = self._static_contact(stepper, state)
+            pa = self.rough.pressure(state.d)[0]
+        return self._report(stepper, state, pa)
+
+    def _static_contact(self, stepper, rest):
+        """``rest`` (``P = 0``) moved to the static rough contact.  Each Newton step holds
+        every row at the film's pressure zero (:meth:`held_rows`), ``P - N (a + b d) = 0``
+        with ``d = h + C P``; from ``P = 0`` the iterates rise monotonically to the root
+        (``p_a`` is convex and falling in ``d``), quadratically near it."""
+        held = np.arange(self.N.shape[0])
+        state, change = rest, np.inf
+        for _ in range(_STATIC_ITERATIONS):
+            self._linearize(state.d)
+            F, r = self.held_rows(stepper, None, held)
+            new = stepper.at_rest(rest, F, r - F @ rest.d)  # rest.d: the film at P = 0
+            change = float(np.max(np.abs(new.p - state.p)))
+            state = new
+            if change <= _STATIC_RTOL * float(np.max(np.abs(state.p))):
+                return state
+        raise SolverError(
+            f"the static asperity contact at t = {rest.t:g} (where the run starts: the asperities "
+            f"already press) did not converge in {_STATIC_ITERATIONS} Newton steps (last change "
+            f"{change:.3g} of the pressure). Start the run with the surfaces further apart (a larger "
+            "initial gap), or give a softer asperity stiffness."
+        )
 
     def _report(self, stepper, state, pa_points):
         p_a = np.asarray(self.N @ pa_points).ravel()  # on the free nodes

@@ -96,6 +96,7 @@ class LaggedStepper:
         if name == "lu" and solver_options:
             raise SceneError(f"linear_solver='lu' takes no options, got {sorted(solver_options)}.")
         self.solver = make_linear_solver(name, **solver_options)
+        self._solver_spec = (name, solver_options)
         if name == "lu" and disc.info.get("operator") == "dense":  # a double-precision LU
             from femehl.discretize.mesh import check_mesh_memory
 
@@ -310,6 +311,25 @@ class LaggedStepper:
             state = part.initial(self, state)
         self._budget(state)
         return state
+
+    def at_rest(self, state: State, F, rhs) -> State:
+        """``state`` (at rest, ``p = 0``) with the pressure unknowns ``p`` solving every row
+        held, ``p + F C p = rhs`` (``F`` a sparse film operator): a part's consistent start
+        (a rough surface's asperities pressing at t = 0, :meth:`AsperityContact.initial`).
+        Solved by a linear solver of its own, so the steps' recycled space and
+        preconditioner start as in any run."""
+        name, options = self._solver_spec
+        if not hasattr(self, "_rest_solver"):
+            self._rest_solver = make_linear_solver(name, **options)
+        F = sp.csr_matrix(F)
+        n = self.disc.n
+        # key = inf: a preconditioner factorized here is refreshed at the first step
+        op = StepOperator(D=sp.identity(n, format="csr"), films=[(1.0, F, self._step_product(F))], C=self.C, key=np.inf)
+        ((p, Cp),) = self._rest_solver.solve(op, [np.asarray(rhs, dtype=float)], state.t)
+        if not np.all(np.isfinite(p)):
+            raise SingularSystemError(f"the state at rest at t = {state.t:.6g} has a non-finite pressure.", t=state.t)
+        new = self._state(state.step, state.t, state.hc, state.V, p, Cp, info=state.info)
+        return new.with_own(**state.own)
 
     def _budget(self, state):
         """The energy budget's figures the scene reports (femehl.solver.energetics), into ``state.info``."""

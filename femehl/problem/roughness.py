@@ -282,11 +282,10 @@ class AsperityContact(StepPart):
         with the asperities, ``P = N p_a(h + C P)`` (the static rough contact, by Newton's
         method from ``P = 0``; nothing to do where no asperity touches).  A substrate with a
         memory starts undeformed, as a smooth one does."""
-        pa = self.rough.pressure(state.d)[0]
-        if np.any(pa > 0.0) and stepper.memory is None:
+        touching = np.any(state.d < _T_CONTACT * self.rough.sigma)
+        if touching and stepper.memory is None:
             state = self._static_contact(stepper, state)
-            pa = self.rough.pressure(state.d)[0]
-        return self._report(stepper, state, pa)
+        return self._report(stepper, state, self.rough.pressure(state.d)[0])
 
     def _static_contact(self, stepper, rest):
         """``rest`` (``P = 0``) moved to the static rough contact.  Each Newton step holds
@@ -294,11 +293,11 @@ class AsperityContact(StepPart):
         with ``d = h + C P``; from ``P = 0`` the iterates rise monotonically to the root
         (``p_a`` is convex and falling in ``d``), quadratically near it."""
         held = np.arange(self.N.shape[0])
-        state, change = rest, np.inf
+        state, change, solver = rest, np.inf, stepper.linear_solver()
         for _ in range(_STATIC_ITERATIONS):
             self._linearize(state.d)
             F, r = self.held_rows(stepper, None, held)
-            new = stepper.at_rest(rest, F, r - F @ rest.d)  # rest.d: the film at P = 0
+            new = stepper.at_rest(rest, F, r - F @ rest.d, solver)  # rest.d: the film at P = 0
             change = float(np.max(np.abs(new.p - state.p)))
             state = new
             if change <= _STATIC_RTOL * float(np.max(np.abs(state.p))):

@@ -312,22 +312,27 @@ class LaggedStepper:
         self._budget(state)
         return state
 
-    def at_rest(self, state: State, F, rhs) -> State:
-        """``state`` (at rest, ``p = 0``) with the pressure unknowns ``p`` solving every row
-        held, ``p + F C p = rhs`` (``F`` a sparse film operator): a part's consistent start
-        (a rough surface's asperities pressing at t = 0, :meth:`AsperityContact.initial`).
-        Solved by a linear solver of its own, so the steps' recycled space and
-        preconditioner start as in any run."""
+    def linear_solver(self):
+        """A new linear solver of the kind and options the steps use (a part's own solves:
+        :meth:`at_rest`), so the steps' recycled space and preconditioner start as in any run."""
         name, options = self._solver_spec
-        if not hasattr(self, "_rest_solver"):
-            self._rest_solver = make_linear_solver(name, **options)
+        return make_linear_solver(name, **options)
+
+    def at_rest(self, state: State, F, rhs, solver) -> State:
+        """``state`` (at rest, ``p = 0``) with the pressure unknowns ``p`` solving every row
+        held, ``p + F C p = rhs`` (``F`` a sparse film operator), by ``solver``
+        (:meth:`linear_solver`): a part's consistent start (a rough surface's asperities
+        pressing at t = 0, :meth:`AsperityContact.initial`)."""
         F = sp.csr_matrix(F)
-        n = self.disc.n
-        # key = inf: a preconditioner factorized here is refreshed at the first step
-        op = StepOperator(D=sp.identity(n, format="csr"), films=[(1.0, F, self._step_product(F))], C=self.C, key=np.inf)
-        ((p, Cp),) = self._rest_solver.solve(op, [np.asarray(rhs, dtype=float)], state.t)
+        eye = sp.identity(self.disc.n, format="csr")
+        op = StepOperator(D=eye, films=[(1.0, F, self._step_product(F))], C=self.C, key=np.inf)
+        ((p, Cp),) = solver.solve(op, [np.asarray(rhs, dtype=float)], state.t)
         if not np.all(np.isfinite(p)):
-            raise SingularSystemError(f"the state at rest at t = {state.t:.6g} has a non-finite pressure.", t=state.t)
+            raise SingularSystemError(
+                f"the state at rest at t = {state.t:.6g} has a non-finite pressure: the static "
+                "system is singular. Start the run with the surfaces further apart.",
+                t=state.t,
+            )
         new = self._state(state.step, state.t, state.hc, state.V, p, Cp, info=state.info)
         return new.with_own(**state.own)
 

@@ -226,7 +226,8 @@ def test_the_fast_operator_runs_a_free_indenters_first_steps():
         for op in ("fast", "dense")
     }
     fast, dense = runs["fast"], runs["dense"]
-    assert fast.info.get("recycle_resets", 0) >= 1  # the case of the fault
+    # the stall is a rounding event: it happened where this test was written (a CPU with
+    # AVX-512), not on every machine; the reset it needs is checked on its own below
     assert fast.nsteps == dense.nsteps
     # measured: films 7e-8, hc 2e-6, the load 3.2e-5 of its largest (it grows from 0, and
     # the fast operator's 1e-6 deflection error is magnified by the squeeze's 1/dt at the
@@ -234,3 +235,37 @@ def test_the_fast_operator_runs_a_free_indenters_first_steps():
     np.testing.assert_allclose(fast.film_min, dense.film_min, rtol=3e-7)
     np.testing.assert_allclose(fast.hc, dense.hc, rtol=6e-6)
     np.testing.assert_allclose(fast.load, dense.load, rtol=0, atol=1e-4 * np.max(np.abs(dense.load)))
+
+
+def test_a_stalled_solve_is_solved_again_without_the_recycled_space(monkeypatch):
+    """The fault of the test above, made to happen: a solve with a fresh preconditioner
+    that does not converge while recycled solutions are kept is solved again without them
+    (``recycle_resets``), and the answer is the system's."""
+    import scipy.sparse as sp
+
+    from femehl.solver.linsolve import RecycledGCR, StepOperator
+
+    rng = np.random.default_rng(0)
+    n, ne = 12, 20
+    C = rng.random((ne, n)) / n
+    F = sp.csr_matrix(rng.random((n, ne)) / ne)
+    op = StepOperator(D=sp.identity(n, format="csr") * 2.0, films=[(1.0, F, F @ C)], C=C, key=1.0)
+    solver = RecycledGCR()
+    b = rng.random(n)
+    solver.solve(op, [b], 0.0)  # leaves a recycled solution
+    assert solver.solutions
+    krylov, calls = solver._krylov, []
+
+    def stall_once(*args):
+        calls.append(bool(solver.solutions or solver.directions))
+        if len(calls) == 1:  # the recycled space's rounding: no convergence
+            return None, None, None, 0, []
+        return krylov(*args)
+
+    monkeypatch.setattr(solver, "_krylov", stall_once)
+    solver.factor.stale = True  # a fresh preconditioner: the stall is not its fault
+    b2 = rng.random(n)
+    ((x, _),) = solver.solve(op, [b2], 0.0)
+    A = 2.0 * np.eye(n) + F @ C
+    assert calls == [True, False] and solver.info["recycle_resets"] == 1
+    np.testing.assert_allclose(A @ x, b2, rtol=1e-7, atol=1e-12)

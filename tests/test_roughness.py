@@ -100,6 +100,46 @@ def test_a_line_started_in_contact_starts_on_its_asperities(k, hc, cavitation):
     assert res.load[-1] / res.load[0] - 1 == pytest.approx(0.0, abs=1e-10)
 
 
+@pytest.mark.parametrize("cavitation", [None, "reynolds"])
+def test_a_line_started_in_contact_under_load_carries_it(cavitation):
+    """Under an imposed load the start at rest carries ``F(0)``: hc is one more unknown of
+    the static contact (measured: the pointwise dry contact at that hc carries the load to
+    4.5e-5, the pressure 1.3e-4 of its peak; hc moves by 2e-16 over 25 steps).  At
+    ``F(0) = 0`` the indenter starts where the asperities do not touch, and the run under
+    the Reynolds condition goes on (it stopped at the step floor at t = 5e-7)."""
+    rough, x = Roughness(0.05, 2.0), np.linspace(-2.5, 2.5, 5001)
+    for F0 in (0.3, 0.0):
+        motion = Motion(gap=0.02, velocity=0.05, load=RampHold(F0, 0.3, 1.0))
+        scene = LineScene(k=1.0, L=2.5, beta=10.0, motion=motion, roughness=rough, cavitation=cavitation)
+        res = femehl.solve(scene, t_end=0.5, n_elements=400, step_tol=1e-4, estimate=False)
+        start = res.states[0]
+        assert start.load == pytest.approx(F0, abs=1e-12)
+        if F0 > 0.0:
+            dry = np.trapezoid(_line_dry(rough, 1.0, start.hc, x), x)
+            assert dry / F0 - 1 == pytest.approx(0.0, abs=2e-4)
+            assert res.t[1] > 0.0 and abs(res.hc[1] - start.hc) < 1e-3  # no jump
+        else:
+            lowest = start.info["film_points_min"]  # where the lift is measured
+            assert lowest == pytest.approx(8.5 * rough.sigma, rel=1e-12) and start.p.max() == 0.0
+        assert res.t[-1] == pytest.approx(0.5)
+
+
+def test_a_free_indenter_started_in_contact_starts_where_it_is():
+    """A free indenter's position is its initial condition: it starts at hc(0), on the
+    asperities' static contact there (its load then accelerates it)."""
+    rough = Roughness(0.05, 2.0)
+    motion = Motion(gap=0.02, velocity=0.0, mass=1.0, force=0.05)
+    res = femehl.solve(
+        LineScene(k=1.0, L=2.0, beta=1e4, motion=motion, roughness=rough),
+        t_end=0.05,
+        n_elements=400,
+        dt=0.01,
+        estimate=False,
+    )
+    start, exact = res.states[0], _line_dry(rough, 1.0, 0.02, res.disc.x)
+    assert start.hc == 0.02 and np.max(np.abs(start.p - exact)) / exact.max() < 2e-4
+
+
 def test_a_sphere_started_in_contact_starts_on_its_asperities():
     """The sphere's start on its asperities (Reynolds condition) against the axisymmetric
     Newton solution (femehl.reference): second order in the mesh size (measured 1.26 % on

@@ -280,12 +280,30 @@ class AsperityContact(StepPart):
     def initial(self, stepper, state):
         """The start at rest: the film at ambient pressure and the substrate in equilibrium
         with the asperities, ``P = N p_a(h + C P)`` (the static rough contact, by Newton's
-        method from ``P = 0``; nothing to do where no asperity touches).  A substrate with a
-        memory starts undeformed, as a smooth one does."""
-        touching = np.any(state.d < _T_CONTACT * self.rough.sigma)
-        if touching and stepper.memory is None:
-            state = self._static_contact(stepper, state)
+        method from ``P = 0``; nothing to do where no asperity touches).  Under an imposed
+        load it carries the load ``F(0)``: hc is one more unknown, and at ``F(0) = 0`` the
+        indenter starts where the asperities no longer touch.  A substrate with a memory
+        starts undeformed, as a smooth one does."""
+        if np.any(state.d < _T_CONTACT * self.rough.sigma) and stepper.memory is None:
+            if stepper.gap.rest_load(stepper, state.t) == 0.0:
+                state = self._lifted(stepper, state)
+            else:
+                state = self._static_contact(stepper, state)
         return self._report(stepper, state, self.rough.pressure(state.d)[0])
+
+    def _lifted(self, stepper, rest):
+        """``rest`` with hc raised until no film is within ``8.5 sigma`` (logged)."""
+        import logging
+
+        lift = _T_CONTACT * self.rough.sigma - float(np.min(rest.d))
+        logging.getLogger("femehl").info(
+            "femehl: the imposed load is 0 at t = %g and the asperities touched at hc(0) = %g: "
+            "the indenter starts at hc = %g, where they do not",
+            rest.t,
+            rest.hc,
+            rest.hc + lift,
+        )
+        return stepper.at_rest(dataclasses.replace(rest, hc=rest.hc + lift))
 
     def _static_contact(self, stepper, rest):
         """``rest`` (``P = 0``) moved to the static rough contact.  Each Newton step holds
@@ -297,10 +315,10 @@ class AsperityContact(StepPart):
         for _ in range(_STATIC_ITERATIONS):
             self._linearize(state.d)
             F, r = self.held_rows(stepper, None, held)
-            new = stepper.at_rest(rest, F, r - F @ rest.d, solver)  # rest.d: the film at P = 0
-            change = float(np.max(np.abs(new.p - state.p)))
+            new = stepper.at_rest(rest, F, r, solver)
+            change = max(float(np.max(np.abs(new.p - state.p))), abs(new.hc - state.hc))
             state = new
-            if change <= _STATIC_RTOL * float(np.max(np.abs(state.p))):
+            if change <= _STATIC_RTOL * max(float(np.max(np.abs(state.p))), abs(state.hc)):
                 return state
         raise SolverError(
             f"the static asperity contact at t = {rest.t:g} (where the run starts: the asperities "

@@ -76,6 +76,33 @@ class GapControl(StepPart):
         and the control's own variables after the step."""
         raise NotImplementedError
 
+    def rest_load(self, stepper, t):
+        """The load a state at rest at ``t`` carries, or None where hc is given (a gap, or
+        a free indenter's position)."""
+        return None
+
+    def rest(self, stepper, solutions, state):
+        """``(x, Cp, hc)`` of a state at rest (:meth:`LaggedStepper.at_rest`) from the
+        solutions for :meth:`rhs`'s right-hand sides: hc as ``state`` has it ..."""
+        n = stepper.disc.n
+        if len(solutions) == 1:
+            ((x, Cp),) = solutions
+            return x, Cp, state.hc
+        (x1, cx1), (x2, cx2) = solutions
+        load = self.rest_load(stepper, state.t)
+        hc = state.hc
+        if load is not None:  # ... or carrying its load: hc from the load row
+            g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
+            if not np.isfinite(g2) or g2 == 0.0:
+                raise SingularSystemError(
+                    f"the state at rest at t = {state.t:.6g}: the load row is singular (the "
+                    "asperities do not respond to hc). Start with the surfaces further apart.",
+                    t=state.t,
+                )
+            hc = (g1 - load) / g2
+        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
+        return x1 - hc * x2, Cp, hc
+
 
 class ImposedGap(GapControl):
     """``hc(t)`` given: one right-hand side."""
@@ -105,6 +132,9 @@ class ImposedLoad(GapControl):
         Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
         return x1 - hc * x2, Cp, hc, own
 
+    def rest_load(self, stepper, t):
+        return stepper.scene.motion.F(t)
+
     def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
         """``(hc, own)``: the load row ``g . p = F``."""
         if not np.isfinite(g2) or g2 == 0.0:
@@ -121,6 +151,9 @@ class FreeIndenter(ImposedLoad):
 
     def initial(self, stepper, state):
         return state.with_own(hc_dot=stepper.scene.motion.hc_dot0)
+
+    def rest_load(self, stepper, t):
+        return None  # its position hc(0) is an initial condition: it starts where it is
 
     def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
         """``(hc, own)`` by the step's own scheme (BDF2 with its variable-step coefficients, or Euler) on hc

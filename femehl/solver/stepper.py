@@ -318,22 +318,29 @@ class LaggedStepper:
         name, options = self._solver_spec
         return make_linear_solver(name, **options)
 
-    def at_rest(self, state: State, F, rhs, solver) -> State:
+    def at_rest(self, state: State, F=None, rhs=None, solver=None) -> State:
         """``state`` (at rest, ``p = 0``) with the pressure unknowns ``p`` solving every row
-        held, ``p + F C p = rhs`` (``F`` a sparse film operator), by ``solver``
-        (:meth:`linear_solver`): a part's consistent start (a rough surface's asperities
-        pressing at t = 0, :meth:`AsperityContact.initial`)."""
+        held, ``p + F C p = rhs - F h`` (``F`` a sparse film operator, ``h = hc + s`` the
+        film at ``p = 0``), by ``solver`` (:meth:`linear_solver`), with hc as the motion's
+        control has it at rest (:meth:`GapControl.rest`: given, or carrying the imposed
+        load): a part's consistent start (a rough surface's asperities pressing at t = 0,
+        :meth:`AsperityContact.initial`).  ``F = None``: nothing presses, ``p = 0`` at
+        ``state.hc``."""
+        if F is None:
+            new = self._state(state.step, state.t, state.hc, state.V, np.zeros(self.disc.n), info=state.info)
+            return new.with_own(**state.own)
         F = sp.csr_matrix(F)
         eye = sp.identity(self.disc.n, format="csr")
         op = StepOperator(D=eye, films=[(1.0, F, self._step_product(F))], C=self.C, key=np.inf)
-        ((p, Cp),) = solver.solve(op, [np.asarray(rhs, dtype=float)], state.t)
-        if not np.all(np.isfinite(p)):
+        rhs_list = self.gap.rhs(self, np.asarray(rhs, dtype=float), F, self.shape, state.t)
+        p, Cp, hc = self.gap.rest(self, solver.solve(op, rhs_list, state.t), state)
+        if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
             raise SingularSystemError(
                 f"the state at rest at t = {state.t:.6g} has a non-finite pressure: the static "
                 "system is singular. Start the run with the surfaces further apart.",
                 t=state.t,
             )
-        new = self._state(state.step, state.t, state.hc, state.V, p, Cp, info=state.info)
+        new = self._state(state.step, state.t, hc, state.V, p, Cp, info=state.info)
         return new.with_own(**state.own)
 
     def _budget(self, state):

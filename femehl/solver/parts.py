@@ -83,25 +83,8 @@ class GapControl(StepPart):
 
     def rest(self, stepper, solutions, state):
         """``(x, Cp, hc)`` of a state at rest (:meth:`LaggedStepper.at_rest`) from the
-        solutions for :meth:`rhs`'s right-hand sides: hc as ``state`` has it ..."""
-        n = stepper.disc.n
-        if len(solutions) == 1:
-            ((x, Cp),) = solutions
-            return x, Cp, state.hc
-        (x1, cx1), (x2, cx2) = solutions
-        load = self.rest_load(stepper, state.t)
-        hc = state.hc
-        if load is not None:  # ... or carrying its load: hc from the load row
-            g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
-            if not np.isfinite(g2) or g2 == 0.0:
-                raise SingularSystemError(
-                    f"the state at rest at t = {state.t:.6g}: the load row is singular (the "
-                    "asperities do not respond to hc). Start with the surfaces further apart.",
-                    t=state.t,
-                )
-            hc = (g1 - load) / g2
-        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
-        return x1 - hc * x2, Cp, hc
+        solutions for :meth:`rhs`'s right-hand sides."""
+        raise NotImplementedError
 
 
 class ImposedGap(GapControl):
@@ -113,6 +96,10 @@ class ImposedGap(GapControl):
     def close(self, stepper, solutions, state, t_new, dt, ctx):
         ((x, Cp),) = solutions
         return x, Cp, stepper.scene.motion.hc(t_new), {}
+
+    def rest(self, stepper, solutions, state):
+        ((x, Cp),) = solutions
+        return x, Cp, state.hc
 
 
 class ImposedLoad(GapControl):
@@ -134,6 +121,24 @@ class ImposedLoad(GapControl):
 
     def rest_load(self, stepper, t):
         return stepper.scene.motion.F(t)
+
+    def rest(self, stepper, solutions, state):
+        """At rest the load row holds ``F(t)`` (hc from it as in a step), or hc is as
+        ``state`` has it where :meth:`rest_load` is None (a free indenter's position)."""
+        (x1, cx1), (x2, cx2) = solutions
+        load, hc = self.rest_load(stepper, state.t), state.hc
+        if load is not None:
+            n = stepper.disc.n
+            g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
+            if not np.isfinite(g2) or g2 == 0.0:
+                raise SingularSystemError(
+                    f"the state at rest at t = {state.t:.6g}: the load row is singular (the "
+                    "asperities do not respond to hc). Start with the surfaces further apart.",
+                    t=state.t,
+                )
+            hc = (g1 - load) / g2
+        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
+        return x1 - hc * x2, Cp, hc
 
     def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
         """``(hc, own)``: the load row ``g . p = F``."""

@@ -83,13 +83,14 @@ def test_zero_speed_line_is_the_dry_rough_contact(k, hc):
 
 
 @pytest.mark.parametrize("cavitation", [None, "reynolds"])
-@pytest.mark.parametrize("k, hc", [(1.0, 0.02), (10.0, 0.01)])
+@pytest.mark.parametrize("k, hc", [(1.0, 0.02), (10.0, 0.01), (10.0, -0.3)])
 def test_a_line_started_in_contact_starts_on_its_asperities(k, hc, cavitation):
     """The gap held from t = 0 with the asperities pressing: the run starts at rest (the
     film at ambient pressure, the substrate on the asperities: the pointwise dry contact)
     and nothing moves after, with or without the Reynolds condition (a start undeformed
-    under that condition was no equilibrium).  Measured: 7.0e-5 and 7.1e-5 of the peak
-    pressure on 400 elements; the load after 25 steps within 4e-14 of the start's."""
+    under that condition was no equilibrium); at hc = -0.3 (-6 sigma) the mean planes
+    overlap from the start.  Measured: 7.0e-5 and 7.1e-5 of the peak pressure on 400
+    elements; the load after 25 steps within 4e-14 of the start's."""
     rough = Roughness(sigma=0.05, stiffness=2.0)
     motion = Motion(gap=hc, velocity=0.0)
     scene = LineScene(k=k, L=2.0, beta=1e4, motion=motion, roughness=rough, cavitation=cavitation)
@@ -279,6 +280,19 @@ def test_cavitated_rows_hold_the_film_pressure():
     assert film[free].min() > -1e-6 * np.max(P) and state.info["p_negative_min"] > -1e-6
     assert np.max(np.asarray(state.own["p_asperity"])[held]) > 0.01  # the asperities touch there
     assert 0.6 < state.info["asperity_share"] < full.info["asperity_share"] - 0.05
+
+
+def test_a_rough_start_may_overlap_down_to_the_film_limit():
+    """A rough scene may start with its mean planes overlapping (the run starts on the
+    asperities), down to the lowest film a run may reach, -10 sigma; a smooth one may not."""
+    rough = Roughness(sigma=0.05, stiffness=2.0)
+    assert Scene(motion=Motion(gap=-0.45), roughness=rough).motion.hc(0.0) == -0.45
+    with pytest.raises(SceneError, match=r"must be > -0.5 \(with this roughness: above -0.5, -10 sigma\)"):
+        Scene(motion=Motion(gap=-0.55), roughness=rough)
+    with pytest.raises(SceneError, match=r"must be > 0: with p = 0"):
+        Scene(motion=Motion(gap=-0.45))
+    with pytest.raises(SceneError, match=r"hc\(0\) = -0.6 must be > -0.5 \(with this roughness"):
+        LineScene(k=1.0, motion=Motion(gap=-0.6), roughness=rough)
 
 
 def test_bad_roughness_input():

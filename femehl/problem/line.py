@@ -144,18 +144,18 @@ class LineDomain:
                 f"LineScene profile s(x) is not finite at x = {bad:.4g}: the rigid gap must be "
                 f"finite on the whole domain [-{self.L:g}, {self.L:g}]."
             )
-        i = int(np.argmin(s))
-        if s[i] + hc0 <= 0.0:
+        i, low = int(np.argmin(s)), scene.lowest_initial_film
+        if s[i] + hc0 <= low:
             if isinstance(scene.indenter, Cylinder):
                 raise SceneError(
-                    f"initial clearance hc(0) = {hc0:g} must be > 0: with p = 0 at t = 0 the film "
-                    "thickness d = hc + x^2/2 would be <= 0 at x = 0. Start with a positive gap and "
-                    "indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
+                    f"initial clearance hc(0) = {hc0:g} must be > {low:g}{scene._start_hint()}: with "
+                    "p = 0 at t = 0 the film thickness d = hc + x^2/2 would be too low at x = 0. Start "
+                    "with a larger gap and indent with a ramp, e.g. RampHold(h0=0.1, h_end=-0.5, t1=1.0)."
                 )
             raise SceneError(
-                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= 0 at x = {xs[i]:.4g}: with p = 0 at "
-                f"t = 0 the film must be open everywhere on [-L, L]. Start with hc(0) > {-s[i]:g} "
-                "(and indent with a ramp), or raise the profile."
+                f"initial film hc(0) + s(x) = {s[i] + hc0:g} <= {low:g}{scene._start_hint()} at x = "
+                f"{xs[i]:.4g}: with p = 0 at t = 0 the film must be open everywhere on [-L, L]. Start "
+                f"with hc(0) > {low - s[i]:g} (and indent with a ramp), or raise the profile."
             )
         a = contact_halfwidth(scene)
         if a is not None and self.L < 1.5 * a:

@@ -141,6 +141,12 @@ class Roughness:
         and sliding speed ``sliding`` (``U_s - U_i``): against the sliding."""
         return 0.0 if self.friction == 0.0 else self.friction * float(np.sign(sliding)) * load / self.aspect
 
+    @property
+    def lowest_film(self) -> float:
+        """The lowest film a run may reach, ``-FILM_LIMIT sigma``: a scene may start there
+        too (its start is on the asperities, :meth:`AsperityContact.initial`)."""
+        return -FILM_LIMIT * self.sigma
+
     def pressure(self, d):
         """``(p_a, dp_a/dd)`` at mean separation ``d``."""
         F, dF = greenwood_tripp(np.asarray(d, dtype=float) / self.sigma, 2.5)

@@ -446,11 +446,13 @@ class Domain:
         """SceneError unless the disk holds ``scene``'s run (film open at t = 0, contact inside)."""
         hc0 = scene.motion.hc(0.0)
         scene.motion.surface_speeds(0.0)  # a velocity or SRR history that fails at t = 0 is refused now
-        if hc0 <= 0.0:
+        low = scene.lowest_initial_film
+        if hc0 <= low:
+            gap = "a positive gap" if low == 0.0 else f"a gap above {low:g}"
             raise SceneError(
-                f"initial tip clearance hc(0) = h0 = {hc0:g} must be > 0: with p = 0 at t = 0 the "
-                "film thickness d = hc + s would be <= 0 at the tip. Start with a positive gap "
-                "(the paper case uses h0 = +0.1)."
+                f"initial tip clearance hc(0) = h0 = {hc0:g} must be > {low:g}{scene._start_hint()}: "
+                "with p = 0 at t = 0 the film thickness d = hc + s would be too low at the tip. "
+                f"Start with {gap} (the paper case uses h0 = +0.1)."
             )
         scene._check_domain_holds_contact()
 
@@ -517,13 +519,26 @@ class Scene:
             )
         if not hasattr(self.indenter, "gap"):
             raise SceneError("Scene.indenter must have a gap(x, y) method (e.g. Sphere()).")
-        self.domain.check(self)
         from femehl.problem.cavitation import check_cavitation_scene
         from femehl.problem.roughness import check_roughness
 
+        check_roughness(self.roughness)
+        self.domain.check(self)
         check_cavitation_scene(self)
-        if check_roughness(self.roughness) is not None:
+        if self.roughness is not None:
             self.roughness.check_scene(self)
+
+    @property
+    def lowest_initial_film(self) -> float:
+        """The initial film ``hc(0) + s`` must be above this: 0 (p = 0 at t = 0 on an open
+        film), or with a roughness its lowest film (``-10 sigma``: the mean planes may
+        overlap, the run starts on the asperities)."""
+        return 0.0 if self.roughness is None else self.roughness.lowest_film
+
+    def _start_hint(self) -> str:
+        if self.roughness is None:
+            return ""
+        return f" (with this roughness: above {self.lowest_initial_film:g}, -10 sigma)"
 
     def _check_domain_holds_contact(self):
         """The domain must reach well past the largest contact of the run, for any indenter.
@@ -577,9 +592,10 @@ class Scene:
                 pass
         hc0 = self.motion.hc(0.0)
         dmin = hc0 + float(s_in.min())
-        if dmin <= 0.0:
+        if dmin <= self.lowest_initial_film:
             raise SceneError(
-                f"the initial film hc(0) + s(x, y) reaches {dmin:.3g} <= 0 on the domain: the "
+                f"the initial film hc(0) + s(x, y) reaches {dmin:.3g} <= {self.lowest_initial_film:g}"
+                f"{self._start_hint()} on the domain: the "
                 f"indenter's gap has a minimum {float(s_in.min()):.3g} below its tip. Shift the "
                 "shape so that s >= 0 with s(0, 0) = 0, or start with a larger gap hc(0)."
             )

@@ -196,6 +196,10 @@ class StepMemory:
         ug = np.asarray(self._to_grid @ u).ravel()
         return self._state(self.grid_offset + self.weight * ug, self.offset + self.weight * u, ug, u)
 
+    def own(self, u) -> dict:
+        """The memory's own variables after the step (``state.own``), from ``u = C p``."""
+        return {"creep": self.creep(u)}
+
 
 def _phi(r):
     """``(a, b) = (int_0^1 r e^{-r s} (1 - s) ds, int_0^1 r e^{-r s} s ds)``: the exact
@@ -388,6 +392,20 @@ class CreepMemory:
 
     def rows(self, stepper, system, rhs_list, state, ctx):
         return system, rhs_list, None
+
+    def rest_film(self, stepper) -> StepMemory:
+        """A load put on at rest at t = 0 (:meth:`LaggedStepper.at_rest`): the glassy
+        response ``J0 u``, no creep yet, the load the memory's source from then on."""
+        zeros = lambda points: np.zeros(np.asarray(points).reshape(-1, 2).shape[0])  # noqa: E731
+        return StepMemory(
+            scale=self.solid.J0,
+            offset=zeros(self.points),
+            weight=0.0,
+            grid_offset=zeros(self.grid),
+            _at=zeros,
+            _to_grid=self.to_grid,
+            _state=self._state,
+        )
 
     def film(self, stepper, state, t_new: float, dt: float) -> StepMemory:
         return self.step(state, t_new, dt, stepper.scene.motion.substrate_speed)

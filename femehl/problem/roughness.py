@@ -288,9 +288,9 @@ class AsperityContact(StepPart):
         with the asperities, ``P = N p_a(h + C P)`` (the static rough contact, by Newton's
         method from ``P = 0``; nothing to do where no asperity touches).  Under an imposed
         load it carries the load ``F(0)``: hc is one more unknown, and at ``F(0) = 0`` the
-        indenter starts where the asperities no longer touch.  A substrate with a memory
-        starts undeformed, as a smooth one does."""
-        if np.any(state.d < _T_CONTACT * self.rough.sigma) and stepper.memory is None:
+        indenter starts where the asperities no longer touch.  A viscoelastic substrate
+        answers with its glassy response, the load put on at t = 0 (then it creeps)."""
+        if np.any(state.d < _T_CONTACT * self.rough.sigma):
             if stepper.gap.rest_load(stepper, state.t) == 0.0:
                 state = self._lifted(stepper, state)
             else:

@@ -29,7 +29,9 @@ class StepPart:
     pressure unknowns has two more: ``solid_pressure(state)``, that share (the film's
     pressure is the rest: :meth:`LaggedStepper.film_pressure`), and
     ``held_rows(stepper, ctx, held)``, ``(F, rhs)`` that the rows ``held`` at ``p = 0`` (a
-    cavitated node) add so that they hold the film's pressure.
+    cavitated node) add so that they hold the film's pressure.  A part that changes the film
+    says how the substrate takes a load put on at t = 0: ``rest_film(stepper)``, the film
+    change of :meth:`film` for it (:meth:`LaggedStepper.at_rest`).
     """
 
     def initial(self, stepper, state):

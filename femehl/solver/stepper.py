@@ -324,14 +324,18 @@ class LaggedStepper:
         film at ``p = 0``), by ``solver`` (:meth:`linear_solver`), with hc as the motion's
         control has it at rest (:meth:`GapControl.rest`: given, or carrying the imposed
         load): a part's consistent start (a rough surface's asperities pressing at t = 0,
-        :meth:`AsperityContact.initial`).  ``F = None``: nothing presses, ``p = 0`` at
-        ``state.hc``."""
+        :meth:`AsperityContact.initial`).  A memory's part answers for the substrate
+        (``rest_film``: a viscoelastic solid's glassy response to a load put on at t = 0).
+        ``F = None``: nothing presses, ``p = 0`` at ``state.hc``."""
         if F is None:
             new = self._state(state.step, state.t, state.hc, state.V, np.zeros(self.disc.n), info=state.info)
             return new.with_own(**state.own)
         F = sp.csr_matrix(F)
         eye = sp.identity(self.disc.n, format="csr")
-        op = StepOperator(D=eye, films=[(1.0, F, self._step_product(F))], C=self.C, key=np.inf)
+        films = [f for f in (getattr(part, "rest_film", None) for part in self.parts) if f is not None]
+        film = films[0](self) if films else None  # a memory's response to a load put on now
+        scale = 1.0 if film is None else film.scale
+        op = StepOperator(D=eye, films=[(scale, F, self._step_product(F))], C=self.C, key=np.inf)
         rhs_list = self.gap.rhs(self, np.asarray(rhs, dtype=float), F, self.shape, state.t)
         p, Cp, hc = self.gap.rest(self, solver.solve(op, rhs_list, state.t), state)
         if not (np.all(np.isfinite(p)) and np.isfinite(hc)):
@@ -340,8 +344,10 @@ class LaggedStepper:
                 "system is singular. Start the run with the surfaces further apart.",
                 t=state.t,
             )
-        new = self._state(state.step, state.t, hc, state.V, p, Cp, info=state.info)
-        return new.with_own(**state.own)
+        if Cp is None:
+            Cp = np.asarray(self.C @ p).ravel()
+        new = self._state(state.step, state.t, hc, state.V, p, Cp, info=state.info, mem=film)
+        return new.with_own(**{**state.own, **({} if film is None else film.own(Cp))})
 
     def _budget(self, state):
         """The energy budget's figures the scene reports (femehl.solver.energetics), into ``state.info``."""

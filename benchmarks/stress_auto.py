@@ -130,6 +130,13 @@ def _finished_levels(stderr) -> list:
     return [[float(m.group(1)), int(m.group(2))] for m in pattern.finditer(stderr or "")]
 
 
+def _rough_cells(r: dict, rough: bool) -> str:
+    """The rough table's two columns of a record (blank where its run recorded none)."""
+    if not rough:
+        return ""
+    return f"{r['share_max']:.3g} | {r['film_min_sliding']:.3g} | " if "share_max" in r else "| | "
+
+
 def write_md(records: list, cap: float, rough: bool = False) -> None:
     import collections
 
@@ -180,10 +187,7 @@ def write_md(records: list, cap: float, rough: bool = False) -> None:
         budget = f" (max_wall {r['max_wall']:g})" if r.get("max_wall") is not None else ""
         lines.append(
             f"| {r['beta']:g} | {r['h0']:g} | {r['T']:g} | {r.get('t_end', '')} | {r['status']} | "
-            f"{t_reached} | {cells} | {est} | {fmin} | "
-            + (f"{r['share_max']:.3g} | {r['film_min_sliding']:.3g} | " if "share_max" in r else "")
-            + ("| | " if rough and "share_max" not in r else "")
-            + f"{r['wall_s']:.0f} | "
+            f"{t_reached} | {cells} | {est} | {fmin} | " + _rough_cells(r, rough) + f"{r['wall_s']:.0f} | "
             f"{r.get('cap_s', DEFAULT_CAP):g}{budget} | {run} |"
         )
     _files(rough)[1].write_text("\n".join(lines) + "\n")
@@ -203,15 +207,16 @@ def main(argv=None) -> None:
     )
     ap.add_argument("--resume", action="store_true")
     ap.add_argument("--rough", action="store_true", help="the closing cases with a roughness (ROUGH_CASES)")
-    ap.add_argument("--redo", help='with --resume: "beta,h0,T" triples (";"-separated) run again')
+    ap.add_argument("--redo", help='"beta,h0,T" triples (";"-separated) run again (others are kept)')
     args = ap.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(json.loads(args.worker)), default=float))
         return
     betas = BETAS if not args.only_beta else tuple(float(b) for b in args.only_beta.split(","))
     runs = _files(args.rough)[0]
-    records = [json.loads(s) for s in runs.read_text().splitlines()] if args.resume and runs.is_file() else []
-    if not args.resume:
+    keep = args.resume or args.redo  # --redo keeps every other record, as bench auto's does
+    records = [json.loads(s) for s in runs.read_text().splitlines()] if keep and runs.is_file() else []
+    if not keep:
         runs.write_text("")
     if args.redo:
         redo = {tuple(float(v) for v in c.split(",")) for c in args.redo.split(";")}

@@ -17,6 +17,7 @@ factors): docs/design.md section 18.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from dataclasses import dataclass
 
@@ -27,6 +28,8 @@ from scipy.special import gamma, ndtr, pbdv
 from femehl.errors import SceneError, SolverError
 from femehl.solver.parts import StepPart
 from femehl.validation import check_positive
+
+logger = logging.getLogger("femehl")
 
 __all__ = ["Roughness", "AsperityContact", "greenwood_tripp", "mean_gap", "RESIDUAL", "ROUGH_COLUMNS"]
 
@@ -299,10 +302,8 @@ class AsperityContact(StepPart):
 
     def _lifted(self, stepper, rest):
         """``rest`` with hc raised until no film is within ``8.5 sigma`` (logged)."""
-        import logging
-
         lift = _T_CONTACT * self.rough.sigma - float(np.min(rest.d))
-        logging.getLogger("femehl").info(
+        logger.info(
             "femehl: the imposed load is 0 at t = %g and the asperities touched at hc(0) = %g: "
             "the indenter starts at hc = %g, where they do not",
             rest.t,

@@ -114,33 +114,32 @@ class ImposedLoad(GapControl):
         return [rhs - G @ shape, G @ np.ones(shape.size)]
 
     def close(self, stepper, solutions, state, t_new, dt, ctx):
-        (x1, cx1), (x2, cx2) = solutions
-        n = stepper.disc.n  # a part's own unknowns follow the pressure
-        g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
-        hc, own = self.hc(stepper, state, t_new, dt, ctx, g1, g2)
-        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
-        return x1 - hc * x2, Cp, hc, own
+        hc, own = self.hc(stepper, state, t_new, dt, ctx, *self._loads(stepper, solutions))
+        return (*self._combined(solutions, hc), hc, own)
 
     def rest_load(self, stepper, t):
         return stepper.scene.motion.F(t)
 
     def rest(self, stepper, solutions, state):
-        """At rest the load row holds ``F(t)`` (hc from it as in a step), or hc is as
-        ``state`` has it where :meth:`rest_load` is None (a free indenter's position)."""
+        """At rest the load row holds ``F(t)``, hc from it as in a step; where
+        :meth:`rest_load` is None (a free indenter's position), hc as ``state`` has it."""
+        hc = state.hc
+        if self.rest_load(stepper, state.t) is not None:
+            hc = self.hc(stepper, state, state.t, 0.0, None, *self._loads(stepper, solutions))[0]
+        return (*self._combined(solutions, hc), hc)
+
+    @staticmethod
+    def _loads(stepper, solutions) -> tuple:
+        """``(g . x1, g . x2)``: the loads of the two solutions (a part's own unknowns follow
+        the pressure)."""
+        n = stepper.disc.n
+        return tuple(float(stepper.g @ x[:n]) for x, _ in solutions)
+
+    @staticmethod
+    def _combined(solutions, hc) -> tuple:
+        """``(p, C p)`` of the solution at ``hc``: ``x1 - hc x2`` (C p None if not tracked)."""
         (x1, cx1), (x2, cx2) = solutions
-        load, hc = self.rest_load(stepper, state.t), state.hc
-        if load is not None:
-            n = stepper.disc.n
-            g1, g2 = float(stepper.g @ x1[:n]), float(stepper.g @ x2[:n])
-            if not np.isfinite(g2) or g2 == 0.0:
-                raise SingularSystemError(
-                    f"the state at rest at t = {state.t:.6g}: the load row is singular (the "
-                    "asperities do not respond to hc). Start with the surfaces further apart.",
-                    t=state.t,
-                )
-            hc = (g1 - load) / g2
-        Cp = None if cx1 is None or cx2 is None else cx1 - hc * cx2
-        return x1 - hc * x2, Cp, hc
+        return x1 - hc * x2, (None if cx1 is None or cx2 is None else cx1 - hc * cx2)
 
     def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
         """``(hc, own)``: the load row ``g . p = F``."""

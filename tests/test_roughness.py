@@ -27,13 +27,19 @@ from femehl.solver.energetics import sliding_energetics
 
 
 def test_greenwood_tripp_by_parabolic_cylinder_functions_against_quadrature():
-    # scipy's pbdv is worst near t = 6 (1.1e-9 relative, where F_{5/2} is 1e-10 of its scale),
-    # 1e-13 elsewhere; the reference's quadrature is 5e-14 against mpmath
-    t = np.linspace(-30.0, 30.0, 241)
+    """The solver's F_n is a spline of log F_n on knots 0.01 apart, its values from scipy's pbdv;
+    its slope -n F_{n-1} one of log F_{n-1}; checked between the knots against the reference's
+    quadrature (5e-14 against mpmath).  Interpolation: about h^4 max|(log F)^(4)| / 384 = 3e-11
+    (measured 2.2e-10: pbdv's own error at the knots); pbdv is 3.4e-9 off near t = 5.8, where
+    F_{5/2} is 1e-10 of its scale."""
+    t = np.linspace(-30.0, 30.0, 6001) + 0.0037  # between the knots
+    near = np.abs(t - 5.8) < 0.5
     for n in (2.5, 1.5):
         F, dF = greenwood_tripp(t, n)
-        assert np.max(np.abs(F / ref.greenwood_tripp(t, n) - 1.0)) < 2e-9
-        assert np.max(np.abs(dF / ref.greenwood_tripp_derivative(t, n) - 1.0)) < 2e-9
+        eF = np.abs(F / ref.greenwood_tripp(t, n) - 1.0)
+        edF = np.abs(dF / ref.greenwood_tripp_derivative(t, n) - 1.0)
+        assert eF[~near].max() < 5e-10 and edF[~near].max() < 5e-10, (eF[~near].max(), edF[~near].max())
+        assert eF[near].max() < 5e-9 and edF[near].max() < 5e-9
     F, dF = greenwood_tripp(np.array([-50.0, -40.0]), 2.5)  # continued by the tangent, finite
     assert np.all(np.isfinite(F)) and np.all(dF < 0) and F[0] > F[1]
 
@@ -195,8 +201,10 @@ def test_automatic_mode_on_a_stress_case_started_in_contact():
     )
     auto = femehl.solve(scene, t_end=t_end, tol=tol)
     assert auto.info["auto"]["reached"] and len(auto.info["auto"]["levels"]) >= 2
-    # the start's Newton steps stop at a change of 1e-8 of the pressure
-    assert auto.states[0].info["asperity_share"] == pytest.approx(1.0, abs=1e-8)
+    # the start's Newton steps stop at a change of 1e-8 of the pressure, and each of their
+    # linear solves leaves a residual of 1e-8 (the Krylov rtol): measured 2.6e-9 and 1.1e-8 on
+    # the meshes of two versions' automatic runs
+    assert auto.states[0].info["asperity_share"] == pytest.approx(1.0, abs=3e-8)
     expert = femehl.solve(scene, t_end=t_end, dt=0.005, mesh="fine", scheme="bdf2")
     for name in ("load", "film_center", "film_min"):
         got, want = auto.value_at(name, t_end), expert.value_at(name, t_end)

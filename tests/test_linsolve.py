@@ -58,3 +58,21 @@ def test_the_refresh_saves_the_iterations_of_the_stale_rows(monkeypatch):
     monkeypatch.setattr(linsolve, "HELD_CHANGE", np.inf)
     without = second_solve()
     assert with_rule <= 3 and without >= 15, (with_rule, without)
+
+
+def test_the_replaced_rows_are_the_held_or_the_switched_ones():
+    """The rule reads a Reynolds step's held rows and a JFO step's switched unknowns alike,
+    and counts the rows that changed either way."""
+    base, _ = _operator(n=20, ne=30)
+    assert linsolve._replaced_rows(base) is None
+    held = base.with_fixed(np.array([7, 3, 5]))
+    np.testing.assert_array_equal(linsolve._replaced_rows(held), [3, 5, 7])
+    switched = np.zeros(20, dtype=bool)
+    switched[[2, 4]] = True
+    op = linsolve.SwitchedOperator(base, sp.identity(20, format="csr"), switched)
+    np.testing.assert_array_equal(linsolve._replaced_rows(op), [2, 4])
+    # 3, 5, 7 against 2, 4: five rows changed
+    assert linsolve._rows_moved(np.array([3, 5, 7]), np.array([2, 4]), 4.9)
+    assert not linsolve._rows_moved(np.array([3, 5, 7]), np.array([2, 4]), 5.0)
+    assert not linsolve._rows_moved(None, None, 0.0)
+    assert linsolve._rows_moved(None, np.array([1]), 0.5)

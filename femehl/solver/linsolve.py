@@ -580,23 +580,36 @@ def _key_moved(factored: float, now: float) -> bool:
     return factored - now > KEY_CHANGE * abs(now)
 
 
-#: refresh the preconditioner before a solve when the held rows (:meth:`StepOperator.with_fixed`:
-#: the Reynolds condition's cavitated nodes) differ from the factorized ones in more than this
-#: times :func:`factor_cost` rows.  Each changed row is a rank-one error of the
-#: preconditioner, and they cost Krylov iterations beyond their number: on the rough PDMS
-#: ball (``examples/pdms_ball.toml``, fitted level 1, 10,786 elements, fast operator, to
-#: t = 3) a first solve after 1-4 / 5-19 / 20-49 / 50-99 changed rows took 11 / 20 / 98 /
-#: 93 iterations against 5.8 with none, and the cost balancing refreshed only after such a
-#: solve
+#: refresh the preconditioner before a solve when the rows a step replaced (the Reynolds
+#: condition's held rows, :meth:`StepOperator.with_fixed`; a JFO step's switched unknowns,
+#: :class:`SwitchedOperator`, where its LU cannot follow them, :meth:`SwitchedLU.adapt`)
+#: differ from the factorized ones in more than this times :func:`factor_cost` rows.  Each
+#: changed row is a rank-one error of the preconditioner, and they cost Krylov iterations
+#: beyond their number, while the cost balancing refreshed only after such a solve.  First
+#: solves after 1-4 / 5-19 / 20-49 / 50-99 changed rows, fast operator:
+#: the rough PDMS ball (``examples/pdms_ball.toml``, fitted level 1, 10,786 elements, to
+#: t = 3), 11 / 20 / 98 / 93 preconditioned iterations against 5.8 with none; the paper
+#: sphere with JFO (fitted level 0.5, 11,450 elements, to t = 2), 18 / 32 / 48 (20-49)
+#: against 7.5
 HELD_CHANGE = 1.0
 
 
-def _held_moved(factored, now, cost: float) -> bool:
-    """The held rows ``now`` differ from the ``factored`` ones in more than
-    ``HELD_CHANGE * cost`` rows (either may be None: none held)."""
+def _replaced_rows(op):
+    """The rows ``op`` replaced: held (:meth:`StepOperator.with_fixed`) or switched
+    (:class:`SwitchedOperator`), sorted; None if none."""
+    held = getattr(op, "held", None)
+    if held is not None:
+        return np.sort(np.asarray(held, dtype=np.int64))
+    switched = getattr(op, "switched", None)
+    return None if switched is None else np.flatnonzero(switched)
+
+
+def _rows_moved(factored, now, cost: float) -> bool:
+    """The replaced rows ``now`` differ from the ``factored`` ones in more than
+    ``HELD_CHANGE * cost`` rows (either may be None: none)."""
     a = np.zeros(0, dtype=np.int64) if factored is None else factored
     b = np.zeros(0, dtype=np.int64) if now is None else now
-    if a.size == b.size and (a.size == 0 or np.array_equal(a, b)):
+    if np.array_equal(a, b):
         return False
     return np.setxor1d(a, b, assume_unique=True).size > HELD_CHANGE * cost
 
@@ -608,7 +621,7 @@ class _Factor:
     total: float  # cost of this factor's cycle in iterations: factorization + iterations
     solves: int = 0  # solves of this cycle
     stale: bool = False  # refresh at the next solve
-    held: np.ndarray | None = None  # op.held of the factorized matrix
+    rows: np.ndarray | None = None  # the factorized matrix's replaced rows (_replaced_rows)
 
 
 #: the film ratio min(d) / max|w| below which the Krylov residual is tightened in
@@ -720,14 +733,11 @@ class RecycledGCR:
         if bnorm == 0.0:
             return np.zeros_like(b), None
         f = self.factor
-        fresh = (
-            f is None
-            or f.stale
-            or _key_moved(f.key, op.key)
-            or _held_moved(f.held, getattr(op, "held", None), factor_cost(op))
-        )
+        fresh = f is None or f.stale or _key_moved(f.key, op.key)
         if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
             fresh = not f.lu.adapt(op)
+        elif not fresh:
+            fresh = _rows_moved(f.rows, _replaced_rows(op), factor_cost(op))
         if fresh:
             # drop this frame's reference first: _refactor frees the old factor before it
             # forms the new matrix, which a live local would keep (one n x n array more at
@@ -806,8 +816,7 @@ class RecycledGCR:
         self._own_factorizations += 1
         self._own_factor_s += time.perf_counter() - t0
         self._sync()
-        held = getattr(op, "held", None)
-        self.factor = _Factor(lu, op.key, total=factor_cost(op), held=None if held is None else np.sort(held))
+        self.factor = _Factor(lu, op.key, total=factor_cost(op), rows=_replaced_rows(op))
         return self.factor
 
     def _precondition(self, r):

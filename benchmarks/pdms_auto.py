@@ -20,6 +20,7 @@ import pathlib
 import resource
 import sys
 import time
+
 import tomllib
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -69,7 +70,8 @@ def run(tol: float, label: str | None) -> dict:
 def table() -> str:
     records = [json.loads(line) for line in RECORDS.read_text().splitlines() if line.strip()]
     rows = [
-        "| date | commit | tol | reached, estimate | cells | steps | run walls s | Krylov its / LUs (last run) | wall s | peak MiB | load |",
+        "| date | commit | tol | reached, estimate | cells | steps | run walls s "
+        "| Krylov its / LUs (last run) | wall s | peak MiB | load |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in records:

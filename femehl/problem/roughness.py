@@ -60,9 +60,8 @@ _T_CONTACT = 8.5
 #: with their exact slopes at knots this far apart over [_T_LOW, _T_ZERO]): against the
 #: Gauss-Legendre reference, relative errors below 3e-10 on [-30, 30] but near t = 5.8,
 #: where scipy's ``pbdv`` (the knots' values) is itself 3.4e-9 off (tests/test_roughness.py).
-#: The parabolic cylinder function took 23 ms a
-#: call on the 10,786 elements of the PDMS ball's fitted level 1, 8 % of its run (25 s of
-#: 316 s, two calls a step); the spline takes about 1 ms
+#: ``pbdv`` at every element took 23 ms a call on the 10,786 elements of the PDMS ball's
+#: fitted level 1, 8 % of its run (25 s of 316 s, two calls a step); the two splines 3 ms
 _GT_KNOT = 0.01
 
 

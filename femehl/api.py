@@ -175,7 +175,13 @@ def solve(
     check_tolerances(automatic, tol, step_tol)
     run = _automatic if automatic else _expert
     kw = dict(t_end=t_end, dt=dt, store_every=store_every, callback=callback, folder=folder, progress=bars)
-    result = run(scene, method, tol=tol, step_tol=step_tol, estimate=estimate, saved=saved, **kw, **options)
+    kw.update(tol=tol, step_tol=step_tol, estimate=estimate, saved=saved)
+    try:
+        result = run(scene, method, **kw, **options)
+    except BaseException:
+        if folder is not None:
+            folder.stopped()
+        raise
     return result if folder is None else folder.finish(result)
 
 

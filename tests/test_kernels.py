@@ -33,6 +33,7 @@ from scipy.special import ellipe
 from femehl.discretize.mesh import load_mesh
 from femehl.discretize.polar_grid import PolarGrid
 from femehl.elastic.kernels import (
+    edge_products,
     edge_terms,
     influence_matrix,
     mesh_edges,
@@ -279,6 +280,27 @@ def test_edge_terms_mirror_is_the_mirrored_edges_subtracted(random_mesh):
     tri = np.transpose(P[t], (1, 0, 2))
     X = triangle_influence(pts, tri) + triangle_influence(pts, tri * np.array([1.0, -1.0]))
     np.testing.assert_allclose(np.asarray((S.T @ T.T).T), X, rtol=1e-10, atol=1e-12)
+
+
+def test_edge_products_are_the_terms_times_the_sparse_map(random_mesh):
+    """``edge_products(pts, P, edges, SP)`` (rows of T contracted as they are made) equals
+    ``edge_terms(...) @ SP`` to round-off, mirrored or not, for the half-disk map ``S P`` of
+    element averages and for a random sparse SP; a SP of the wrong height is refused."""
+    import scipy.sparse as sp
+
+    P, t, rng = random_mesh
+    edges, S = mesh_edges(t, P)
+    pts = np.vstack([P, rng.random((30, 2)) * 2.0 - 0.5])
+    ne = t.shape[1]
+    rows = np.repeat(np.arange(ne), 3)
+    avg = sp.csr_matrix((np.full(3 * ne, 1 / 3), (rows, t.T.ravel())), (ne, P.shape[0]))
+    for SP in (S @ avg, sp.random(edges.shape[0], 17, density=0.3, random_state=rng)):
+        for mirror in (False, True):
+            want = np.asarray(sp.csr_matrix(SP).T @ edge_terms(pts, P, edges, mirror=mirror).T).T
+            got = edge_products(pts, P, edges, SP, mirror=mirror)
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-13 * np.abs(want).max())
+    with pytest.raises(ValueError, match="rows"):
+        edge_products(pts, P, edges, sp.csr_matrix((3, 4)))
 
 
 def test_influence_matrix_mirror():

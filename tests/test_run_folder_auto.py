@@ -99,3 +99,39 @@ def test_a_full_disk_at_the_estimate_is_femehls_error(tmp_path, monkeypatch):
     with pytest.raises(OutputError, match="No space left.*resume"):
         run_to_folder(SCENE, folder, **RUN)
     assert (folder / "summary.csv").is_file()  # what was written stays
+
+
+def test_the_history_is_drawn_once_with_the_estimate(tmp_path, monkeypatch):
+    """The answer's history.png is drawn once, after its estimate is in summary.csv (the
+    run's writer leaves it to the folder's finish); a fault in the companions after the run
+    ended still leaves a history.png of what was written."""
+    import femehl.accuracy.auto as auto
+    import femehl.output.plots as plots
+
+    drawn = []
+    draw = plots.history_png
+
+    def counted(table, path, **kw):
+        drawn.append(sorted(c for c in table if c.startswith("err_")))
+        return draw(table, path, **kw)
+
+    monkeypatch.setattr(plots, "history_png", counted)
+    folder = tmp_path / "run"
+    run_to_folder(SCENE, folder, **RUN)
+    assert len(drawn) == 1 and drawn[0], drawn  # one drawing, with the error columns
+    assert (folder / "history.png").stat().st_size > 10_000
+
+    replays, calls = auto.replays, []
+
+    def interrupted(*args, **kwargs):  # Ctrl-C in the written candidate's companions
+        calls.append(1)
+        if len(calls) > 1:
+            raise KeyboardInterrupt
+        return replays(*args, **kwargs)  # the first run's (in memory)
+
+    drawn.clear()
+    monkeypatch.setattr(auto, "replays", interrupted)
+    folder = tmp_path / "cut"
+    with pytest.raises(KeyboardInterrupt):
+        run_to_folder(SCENE, folder, **RUN)
+    assert len(drawn) == 1 and not drawn[0] and (folder / "history.png").stat().st_size > 10_000

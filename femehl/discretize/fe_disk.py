@@ -30,7 +30,7 @@ from femehl.discretize.mesh import areas, centroids, load_mesh
 from femehl.elastic.base import OPERATORS, substrate_operators
 from femehl.elastic.hmatrix import DEFAULT_OPERATOR_TOL, FastOptions
 from femehl.elastic.kernels import (
-    edge_terms,
+    edge_products,
     mesh_edges,
     radial_influence,
     smooth_cost_estimates,
@@ -236,9 +236,10 @@ class FEDisc(P1P0):
 
         Dense, or with ``operator="fast"`` a :class:`femehl.elastic.hmatrix.FastCompliance`.
 
-        X is never stored: with the signed edge incidence S of :func:`mesh_edges`, X = T S
-        where T holds one exact term per unique edge, so a block of rows is T_block (S P).
-        For a half disk the mirror images (orientation reversed) add -T_mirror S.
+        Neither X nor T is stored: with the signed edge incidence S of :func:`mesh_edges`,
+        X = T S where T holds one exact term per unique edge, and each row of T is contracted
+        with S P as it is made (:func:`femehl.elastic.kernels.edge_products`).  For a half
+        disk the mirror images (orientation reversed) add -T_mirror S.
         """
         t0, say = time.perf_counter(), self.nelements >= LONG_SETUP_CELLS
         if say:
@@ -256,16 +257,8 @@ class FEDisc(P1P0):
         return op
 
     def _dense_boussinesq(self):
-        ne = self.nelements
         edges, S = mesh_edges(self.mesh.t, self.nodes)
-        SP = (S @ self.P[:, self.free]).tocsc()  # (nedges, nfree), sparse
-        C = np.empty((ne, self.n))
-        block = max(1, int(2**26 // (8 * edges.shape[0])))
-        for s in range(0, ne, block):
-            e = slice(s, min(s + block, ne))
-            T = edge_terms(self.centroids[e], self.nodes, edges, mirror=self.half)
-            C[e] = (SP.T @ T.T).T
-        return C
+        return edge_products(self.centroids, self.nodes, edges, S @ self.P[:, self.free], mirror=self.half)
 
     def radial_kernel(self, kernel):
         """``X_g P[:, free]``, ``X_g[i, e] = int_{T_e} g(|c_i - x'|) dA'``, mirror included.

@@ -22,6 +22,7 @@ __all__ = [
     "quad_influence",
     "mesh_edges",
     "edge_terms",
+    "edge_products",
     "radial_influence",
     "sparse_radial_influence",
     "radial_triangle_pairs",
@@ -211,48 +212,103 @@ def edge_terms(points, nodes, edges, out=None, mirror=False):
     ``mirror``: minus the term of the edge mirrored in ``y = 0`` (a half disk's image),
     which is the term seen from A mirrored, ``(x, -y)``.
     """
+    pts, nodes, B, C = _edge_arrays(points, nodes, edges)
+    if out is None:
+        out = np.empty((pts.shape[0], B.shape[0]))
+    return _edge_rows(pts, nodes, B, C, bool(mirror), out)
+
+
+def edge_products(points, nodes, edges, SP, mirror=False):
+    """``T SP`` (:func:`edge_terms` times a sparse ``SP``, nedges x m) without forming ``T``.
+
+    Each row of T lives in one scratch row while it is contracted with the columns of SP
+    (CSC), so an n x nedges T is never written: the dense influence ``X P = T (S P)`` of a
+    mesh (:meth:`femehl.discretize.fe_disk.FEDisk.boussinesq`) in one pass.
+    """
+    import scipy.sparse as sp
+
+    pts, nodes, B, C = _edge_arrays(points, nodes, edges)
+    SP = sp.csc_matrix(SP)
+    if SP.shape[0] != B.shape[0]:
+        raise ValueError(f"SP has {SP.shape[0]} rows for {B.shape[0]} edges")
+    SP.sort_indices()
+    out = np.empty((pts.shape[0], SP.shape[1]))
+    return _edge_products(
+        pts, nodes, B, C, bool(mirror), SP.indptr.astype(np.int64), SP.indices.astype(np.int64), SP.data, out
+    )
+
+
+def _edge_arrays(points, nodes, edges):
     pts = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
     nodes = np.ascontiguousarray(np.asarray(nodes, dtype=float))
     edges = np.asarray(edges, dtype=np.int64)
-    if out is None:
-        out = np.empty((pts.shape[0], edges.shape[0]))
-    B, C = (np.ascontiguousarray(edges[:, k]) for k in (0, 1))
-    return _edge_rows(pts, nodes, B, C, bool(mirror), out)
+    return pts, nodes, *(np.ascontiguousarray(edges[:, k]) for k in (0, 1))
+
+
+@numba.njit(cache=True, boundscheck=False)
+def _edge_frames(nodes, B, C):  # pragma: no cover - compiled
+    """Per edge: its length, unit direction and first vertex, as contiguous arrays."""
+    nE = B.shape[0]
+    frame = np.empty((5, nE))
+    for k in range(nE):
+        x = nodes[C[k], 0] - nodes[B[k], 0]
+        y = nodes[C[k], 1] - nodes[B[k], 1]
+        le = math.hypot(x, y)
+        frame[0, k], frame[1, k], frame[2, k] = le, x / le, y / le
+        frame[3, k], frame[4, k] = nodes[B[k], 0], nodes[B[k], 1]
+    return frame
+
+
+@numba.njit(cache=True, boundscheck=False)
+def _edge_row(ax, ay, nodes, B, C, frame, mirror, rho, row):  # pragma: no cover - compiled
+    """``row[k]``: the term of edge k seen from A = (ax, ay), minus the mirrored edge's
+    (``mirror``), which is the term seen from A mirrored, (ax, -ay).  ``rho`` (2, nodes):
+    scratch for the vertex distances from A and from its mirror image."""
+    le, ex, ey, xb, yb = frame[0], frame[1], frame[2], frame[3], frame[4]
+    images = 2 if mirror else 1
+    for m in range(images):
+        ay_m = ay if m == 0 else -ay
+        for j in range(nodes.shape[0]):
+            dx = nodes[j, 0] - ax
+            dy = nodes[j, 1] - ay_m
+            rho[m, j] = math.sqrt(dx * dx + dy * dy)
+    for k in range(B.shape[0]):
+        val = 0.0
+        for m in range(images):
+            bx = xb[k] - ax
+            by = yb[k] - (ay if m == 0 else -ay)
+            h = bx * ey[k] - by * ex[k]  # signed distance of A from the edge's line
+            if abs(h) > 1e-14 * le[k]:
+                sb = bx * ex[k] + by * ey[k]  # positions of B and C along the edge from A's foot
+                sc = sb + le[k]
+                if sb + sc < 0.0:  # the foot beyond C: the mirror form, no cancellation
+                    val += h * math.log((rho[m, B[k]] - sb) / (rho[m, C[k]] - sc))
+                else:
+                    val += h * math.log((sc + rho[m, C[k]]) / (sb + rho[m, B[k]]))
+        row[k] = val
 
 
 @numba.njit(cache=True, boundscheck=False)
 def _edge_rows(pts, nodes, B, C, mirror, out):  # pragma: no cover - compiled
-    nE = B.shape[0]
-    le = np.empty(nE)
-    ex = np.empty(nE)
-    ey = np.empty(nE)
-    for k in range(nE):
-        x = nodes[C[k], 0] - nodes[B[k], 0]
-        y = nodes[C[k], 1] - nodes[B[k], 1]
-        le[k] = math.hypot(x, y)
-        ex[k] = x / le[k]
-        ey[k] = y / le[k]
-    rho = np.empty(nodes.shape[0])
+    frame = _edge_frames(nodes, B, C)
+    rho = np.empty((2, nodes.shape[0]))
     for i in range(pts.shape[0]):
-        ax = pts[i, 0]
-        for m in range(2 if mirror else 1):
-            ay = pts[i, 1] if m == 0 else -pts[i, 1]
-            for j in range(nodes.shape[0]):
-                rho[j] = math.hypot(nodes[j, 0] - ax, nodes[j, 1] - ay)
-            for k in range(nE):
-                bx = nodes[B[k], 0] - ax
-                by = nodes[B[k], 1] - ay
-                h = bx * ey[k] - by * ex[k]
-                val = 0.0
-                if abs(h) > 1e-14 * le[k]:
-                    sb = bx * ex[k] + by * ey[k]
-                    sc = sb + le[k]
-                    if sb + sc < 0.0:
-                        val = h * math.log((rho[B[k]] - sb) / (rho[C[k]] - sc))
-                    else:
-                        val = h * math.log((sc + rho[C[k]]) / (sb + rho[B[k]]))
-                # the mirrored edge seen from A is minus this edge seen from A mirrored
-                out[i, k] = val if m == 0 else out[i, k] + val
+        _edge_row(pts[i, 0], pts[i, 1], nodes, B, C, frame, mirror, rho, out[i])
+    return out
+
+
+@numba.njit(cache=True, boundscheck=False)
+def _edge_products(pts, nodes, B, C, mirror, indptr, indices, data, out):  # pragma: no cover - compiled
+    frame = _edge_frames(nodes, B, C)
+    rho = np.empty((2, nodes.shape[0]))
+    row = np.empty(B.shape[0])
+    for i in range(pts.shape[0]):
+        _edge_row(pts[i, 0], pts[i, 1], nodes, B, C, frame, mirror, rho, row)
+        for j in range(out.shape[1]):
+            acc = 0.0
+            for q in range(indptr[j], indptr[j + 1]):
+                acc += data[q] * row[indices[q]]
+            out[i, j] = acc
     return out
 
 

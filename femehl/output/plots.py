@@ -642,10 +642,13 @@ FIGURES = {
 }
 
 
-def draw_figures(result, folder):
-    """Draw the figures of ``result`` into ``folder``; returns their paths."""
+def draw_figures(result, folder, skip=()):
+    """Draw the figures of ``result`` into ``folder`` (those named in ``skip`` left out);
+    returns their paths."""
     out = []
     for name, draw in FIGURES[result.disc.dimension]:
+        if name in skip:
+            continue
         draw(result, pathlib.Path(folder) / name)
         out.append(pathlib.Path(folder) / name)
     return out

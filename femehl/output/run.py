@@ -77,21 +77,22 @@ def _terms(scene, stepper, t_end: float) -> str:
     )
 
 
-def _pictures(result: Result, folder: pathlib.Path) -> None:
+def _pictures(result: Result, folder: pathlib.Path, skip=()) -> None:
     """The PNGs of the states reached (a failure to draw does not hide the run's outcome)."""
     if not result.states:
         return
     try:
-        draw_figures(result, folder)
+        draw_figures(result, folder, skip)
     except Exception as exc:  # noqa: BLE001 - pictures are a convenience
         logger.warning("femehl: could not draw the PNGs in %s (%s: %s)", folder, type(exc).__name__, exc)
 
 
-def _redraw_history(folder: pathlib.Path) -> None:
-    """history.png again, now with the error estimate's band (a failure only warns)."""
+def _draw_history(folder: pathlib.Path) -> None:
+    """history.png from the folder's summary.csv, with the error estimate's band when its
+    columns are there (a failure only warns)."""
     from femehl.output.plots import plot_history
 
-    if not (folder / "history.png").is_file():
+    if not (folder / "summary.csv").is_file():
         return
     try:
         plot_history(folder)
@@ -114,6 +115,7 @@ class RunFolder:
         self.checkpoint_every = checkpoint_every
         self.path = folder
         self.written = False  # a writer was opened: a later run replaces its files
+        self.history_due = False  # a run ended and left its history.png to finish()
         self.t0 = time.perf_counter()
 
     def check(self, t_end: float, dt: float | None, store_every: int) -> None:
@@ -161,6 +163,8 @@ class RunFolder:
         if not self.written:
             self._write_first(res)
         _write_estimate(self.path, res)
+        if self.history_due or (res.estimate is not None and (self.path / "history.png").is_file()):
+            self._history()  # with the estimate's band, once
         res.info["wall_s"] = time.perf_counter() - self.t0  # companions, first run and candidates too
         if res.estimate is not None and res.estimate.how == "companion":
             self.say(
@@ -169,6 +173,16 @@ class RunFolder:
             )
         self.say_choice(res.info.get("auto", {}))
         return res
+
+    def stopped(self) -> None:
+        """After a fault between a run's end and :meth:`finish` (its companions): the history
+        the run left to finish."""
+        if self.history_due:
+            self._history()
+
+    def _history(self) -> None:
+        _draw_history(self.path)
+        self.history_due = False
 
     def _write_first(self, res: Result) -> None:
         self.say(
@@ -218,7 +232,6 @@ def _write_estimate(folder, res) -> None:
     try:
         if res.estimate is not None:
             add_error_columns(folder / "summary.csv", res.estimate)
-            _redraw_history(folder)
         if "auto" in res.info:
             info = {k: v for k, v in res.info["auto"].items()}
             tmp = folder / "auto.json.tmp"
@@ -340,7 +353,10 @@ class _Writer:
             checkpoint.save_checkpoint(path, state)  # the last good state
         if result is not None:
             result.info["wall_s"] = time.perf_counter() - self.t0
-            _pictures(result, path)
+            # a run that ended is finished by RunFolder.finish (or RunFolder.stopped after a
+            # fault between the two), which draws its history with the estimate: drawn once
+            _pictures(result, path, skip=() if exc is not None else ("history.png",))
+            self.folder.history_due = exc is None and bool(result.states)
         if state is not None and not self.ended:
             say(f"femehl: output up to t = {state.t:g} is in {path}; the checkpoint is at t = {state.t:g}")
         return False

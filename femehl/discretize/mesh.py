@@ -238,7 +238,8 @@ def machine_memory() -> int | None:
 
 
 def operator_bytes(n_elements: int, n_free: int) -> int:
-    """Bytes of the dense elastic operator (elements x free nodes x 8), before the LU copies."""
+    """Bytes of the dense elastic operator as it is built (elements x free nodes x 8; a large
+    one is then kept in single precision, :mod:`femehl.elastic.dense`), before the LU copies."""
     return int(n_elements) * int(n_free) * 8
 
 

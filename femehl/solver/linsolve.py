@@ -22,6 +22,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from femehl.elastic.dense import is_dense
 from femehl.errors import SceneError, SingularSystemError
 from femehl.registry import Registry
 from femehl.validation import check_in_range
@@ -66,7 +67,7 @@ class StepOperator:
 
     @property
     def dense(self) -> bool:
-        return isinstance(self.C, np.ndarray)
+        return is_dense(self.C)
 
     @property
     def fast(self) -> bool:
@@ -370,7 +371,7 @@ class SwitchedLU:
             j = np.flatnonzero(big)
             rhs = r1 - op.base.D[:, j] @ r2[j]
             C = op.base.C
-            if isinstance(C, np.ndarray):  # dense: the columns' product, ne x len(j)
+            if is_dense(C):  # dense: the columns' product, ne x len(j)
                 rhs = rhs - op.base.G @ (C[:, j] @ r2[j])
         y = self._solve_M(rhs)
         x = np.empty(2 * n)
@@ -928,7 +929,7 @@ class RecycledGCR:
         generations instead.
         """
         dense = C.C if isinstance(C, _Leading) else C
-        if not isinstance(dense, np.ndarray):
+        if not is_dense(dense):
             return ages.size == 0 or int(ages.max()) < _MAX_TRACKED
         n = x.size
         if self._probe is None or self._probe[1].shape[1] != n:

@@ -27,6 +27,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from femehl.elastic.dense import SingleCompliance, is_dense, stored
 from femehl.errors import SceneError, SingularSystemError
 from femehl.solver.linsolve import LazyProduct, StepOperator, film_rtol_scale, make_linear_solver
 from femehl.solver.parts import Solved, gap_control
@@ -42,7 +43,7 @@ _ROW_CACHE = 512  # compliance rows of probed nodes kept between steps
 
 
 def _nbytes(a) -> int:
-    if isinstance(a, np.ndarray) or getattr(a, "is_fast", False):
+    if is_dense(a) or getattr(a, "is_fast", False):
         return int(a.nbytes)
     if sp.issparse(a):
         a = a.tocsr()
@@ -103,8 +104,8 @@ class LaggedStepper:
             check_mesh_memory(disc.info["elements"], disc.info["unknowns"], disc.info["mesh"], lu_itemsize=8)
         substrate = scene.substrate
         t1 = time.perf_counter()
-        self.C = substrate.compliance_operator(disc)
-        self.dense = isinstance(self.C, np.ndarray)
+        self.C = stored(substrate.compliance_operator(disc))  # large and dense: single precision
+        self.dense = is_dense(self.C)
         self.fast = bool(getattr(self.C, "is_fast", False))
         if self.fast and name == "lu":
             raise SceneError(
@@ -155,6 +156,8 @@ class LaggedStepper:
                 "krylov_iterations": 0,
             }
         )
+        if self.dense:  # float32 storage for a large C (femehl.elastic.dense), products in float64
+            self.info["operator_storage"] = "float32" if isinstance(self.C, SingleCompliance) else "float64"
         if self.cavitation is not None:  # how the reported fields are to be read
             self.info.update(cavitation=self.cavitation.name, cavitation_note=self.cavitation.note)
         for term in self.terms:  # film products every step needs: formed here, once

@@ -61,8 +61,10 @@ class SingleCompliance:
         return np.column_stack([self @ x[:, j] for j in range(x.shape[1])]).reshape(self.shape[0], -1)
 
     def __rmatmul__(self, w):
-        if sp.issparse(w):  # a film operator F: F C, formed once per term
-            return np.asarray(w @ self.a, dtype=np.float64)
+        if sp.issparse(w):  # a film operator F: F C, formed once per term, no double copy of C
+            w = sp.csr_matrix(w, dtype=np.float64)
+            out = np.zeros((w.shape[0], self.shape[1]))
+            return _csr_rmatmul(w.indptr, w.indices, w.data, self.a, out)
         w = np.atleast_2d(np.asarray(w, dtype=np.float64))
         return _rmatmul(self.a, np.ascontiguousarray(w), np.zeros((w.shape[0], self.shape[1])))
 
@@ -110,4 +112,15 @@ def _rmatmul(A, W, out):  # pragma: no cover - compiled
             if wi != 0.0:
                 for j in range(n):
                     out[r, j] += wi * A[i, j]
+    return out
+
+
+@numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)
+def _csr_rmatmul(indptr, indices, data, A, out):  # pragma: no cover - compiled
+    """``out = W A`` for a CSR ``W`` (float64), A float32, sums in float64."""
+    for r in range(out.shape[0]):
+        for q in range(indptr[r], indptr[r + 1]):
+            wi, i = data[q], indices[q]
+            for j in range(A.shape[1]):
+                out[r, j] += wi * A[i, j]
     return out

@@ -1,0 +1,159 @@
+"""The default path's cost, paired against an older source tree: the README's main job
+(``femehl run``, run folder and pictures included) and the paper case's automatic solve
+(``femehl.solve(paper, t_end=5, tol=1e-2)``, no output: issue 42's "at most 15 s"), each
+a whole process, the two trees in turn pair by pair.  Writes ``default_path.md`` and
+appends the records to ``default_path.jsonl``.
+
+    python benchmarks/default_path.py --before SRC [--pairs 3]
+
+``SRC``: an older checkout's source tree (``git worktree add DIR REV``, or ``git archive REV
+femehl | tar x -C DIR``), run with ``PYTHONPATH=SRC``; the current tree is this checkout's.
+Each solve also reports where its time went (elastic operator, LUs, Krylov solves,
+companions) from ``res.info``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+from _machine import HERE, header, provenance
+
+ROOT = HERE.parent
+JSONL = HERE / "default_path.jsonl"
+BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "FEMEHL_BLAS_THREADS")
+
+SOLVE = r"""
+import json, resource, sys, time
+import femehl
+t0 = time.perf_counter()
+res = femehl.solve(femehl.presets.paper_sphere(), t_end=5.0, tol=1e-2, store_every=0)
+wall = time.perf_counter() - t0
+i, a = res.info, res.info["auto"]
+keys = ("elastic_build_s", "factorizations", "factor_s", "krylov_iterations", "krylov_s", "operator_storage")
+print(json.dumps({
+    "wall_s": wall, "runs_s": a["wall"], "companions_s": a["estimate_wall"], "cells": a["elements"],
+    "steps": a["steps"], "estimate": a["total"], "film_min_end": float(res.film_min[-1]),
+    "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, **{k: i.get(k) for k in keys},
+}))
+"""
+
+
+def _env(src: str) -> dict:
+    env = {k: v for k, v in os.environ.items() if k not in BLAS_VARS and k != "PYTHONPATH"}
+    env.update(PYTHONPATH=src, MPLBACKEND="Agg")
+    return env
+
+
+def run_cli(src: str) -> float:
+    """The README's ``femehl run`` (a fresh folder), its whole-process wall time."""
+    out = pathlib.Path(tempfile.mkdtemp(prefix="femehl-default-path-"))
+    t0 = time.perf_counter()
+    subprocess.run(  # from the scratch folder: a checkout in the working directory would shadow src
+        [sys.executable, "-m", "femehl.cli", "run", "--quiet", "--out", str(out / "run")],
+        cwd=out,
+        env=_env(src),
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    wall = time.perf_counter() - t0
+    shutil.rmtree(out, ignore_errors=True)
+    return wall
+
+
+def run_solve(src: str) -> dict:
+    """The paper case's automatic solve in a fresh process: its figures and whole wall time."""
+    t0 = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, "-c", SOLVE],
+        cwd=tempfile.gettempdir(),
+        env=_env(src),
+        check=True,
+        capture_output=True,
+    )
+    rec = json.loads(done.stdout.decode().strip().splitlines()[-1])
+    rec["process_s"] = time.perf_counter() - t0
+    return rec
+
+
+def _row(label: str, r: dict) -> str:
+    comp = sum(r["companions_s"])
+    return (
+        f"| {label} | {r['wall_s']:.1f} | {' / '.join(f'{w:.1f}' for w in r['runs_s'])} | {comp:.1f} | "
+        f"{r['elastic_build_s']:.1f} | {r['factorizations']} / {r['factor_s']:.1f} | "
+        f"{r['krylov_iterations']} / {r['krylov_s']:.1f} | {r.get('operator_storage') or '-'} | "
+        f"{' / '.join(map(str, r['steps']))} | {100 * r['estimate']:.2f} % | {r['peak_mib']:.0f} |"
+    )
+
+
+def main(argv=None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--before", required=True, help="an older source tree (PYTHONPATH)")
+    p.add_argument("--pairs", type=int, default=3)
+    args = p.parse_args(argv)
+    now, before = str(ROOT), str(pathlib.Path(args.before).resolve())
+    run_cli(now), run_cli(before)  # compile both trees' numba caches first: not timed
+    cli, solves = [], []
+    for i in range(args.pairs):
+        cli.append((run_cli(now), run_cli(before)))
+        solves.append((run_solve(now), run_solve(before)))
+        a, b = solves[-1]
+        print(
+            f"pair {i + 1}: femehl run {cli[-1][0]:.1f} / {cli[-1][1]:.1f} s; "
+            f"solve {a['wall_s']:.1f} / {b['wall_s']:.1f} s",
+            flush=True,
+        )
+    with open(JSONL, "a") as fh:
+        for (c, cb), (a, b) in zip(cli, solves, strict=True):
+            fh.write(json.dumps({**provenance(), "before": before, "cli": [c, cb], "solve": [a, b]}) + "\n")
+    med = statistics.median
+    walls = [(a["wall_s"], b["wall_s"]) for a, b in solves]
+    lines = [
+        "# The default path, paired against an older tree",
+        "",
+        header("default_path.py") + f" Before: `{os.path.basename(before)}`.",
+        "",
+        "Whole processes, the current tree and the older one in turn (a pair each). `femehl run`: the "
+        "README's main job with its run folder and pictures. Solve: `femehl.solve(paper, t_end=5, "
+        "tol=1e-2, store_every=0)`, its wall time from inside (issue 42's target: at most 15 s).",
+        "",
+        "| pair | femehl run now (s) | before (s) | ratio | solve now (s) | before (s) | ratio |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        *(
+            f"| {i + 1} | {c:.1f} | {cb:.1f} | {c / cb:.3f} | {a['wall_s']:.1f} | {b['wall_s']:.1f} | "
+            f"{a['wall_s'] / b['wall_s']:.3f} |"
+            for i, ((c, cb), (a, b)) in enumerate(zip(cli, solves, strict=True))
+        ),
+        "",
+        f"Median ratios: femehl run {med(c / cb for c, cb in cli):.3f} (median {med(c for c, _ in cli):.1f} "
+        f"against {med(cb for _, cb in cli):.1f} s), solve {med(a / b for a, b in walls):.3f} "
+        f"(median {med(a for a, _ in walls):.1f} against {med(b for _, b in walls):.1f} s).",
+        "",
+        "Where each solve's time went (the last run's elastic operator, LUs and Krylov solves; the "
+        "companions of both runs):",
+        "",
+        "| solve | wall (s) | runs (s) | companions (s) | operator (s) | LUs / s | Krylov iterations / s "
+        "| C stored | steps | estimate | peak MiB |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        *(
+            row
+            for i, (a, b) in enumerate(solves)
+            for row in (_row(f"{i + 1}, now", a), _row(f"{i + 1}, before", b))
+        ),
+        "",
+    ]
+    (HERE / "default_path.md").write_text("\n".join(lines))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

@@ -19,13 +19,13 @@ import argparse
 import json
 import os
 import pathlib
-import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
+import first_run
 from _machine import HERE, header, provenance
 
 ROOT = HERE.parent
@@ -60,19 +60,7 @@ def _env(src: str) -> dict:
 
 def run_cli(src: str) -> float:
     """The README's ``femehl run`` (a fresh folder), its whole-process wall time."""
-    out = pathlib.Path(tempfile.mkdtemp(prefix="femehl-default-path-"))
-    t0 = time.perf_counter()
-    subprocess.run(  # from the scratch folder: a checkout in the working directory would shadow src
-        [sys.executable, "-m", "femehl.cli", "run", "--quiet", "--out", str(out / "run")],
-        cwd=out,
-        env=_env(src),
-        check=True,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    wall = time.perf_counter() - t0
-    shutil.rmtree(out, ignore_errors=True)
-    return wall
+    return first_run.run({}, src)
 
 
 def run_solve(src: str, scene: str = "paper") -> dict:

@@ -24,6 +24,7 @@ def test_products_are_those_of_the_rounded_matrix_in_double():
     for got, want in ((S @ x, R @ x), (S @ X, R @ X), (W @ S, W @ R), (F @ S, F @ R)):
         assert got.dtype == np.float64
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-15 * scale)
+    assert (W[0] @ S).shape == (101,)  # a vector on the left, as numpy's
     np.testing.assert_array_equal(S[:, [1, 7]], R[:, [1, 7]])
     np.testing.assert_array_equal(S[[0, 5]], R[[0, 5]])
     assert S.nbytes == C.size * 4 and S.shape == C.shape and is_dense(S)

@@ -61,12 +61,12 @@ class SingleCompliance:
         return np.column_stack([self @ x[:, j] for j in range(x.shape[1])]).reshape(self.shape[0], -1)
 
     def __rmatmul__(self, w):
-        if sp.issparse(w):  # a film operator F: F C, formed once per term, no double copy of C
-            w = sp.csr_matrix(w, dtype=np.float64)
-            out = np.zeros((w.shape[0], self.shape[1]))
-            return _csr_rmatmul(w.indptr, w.indices, w.data, self.a, out)
-        w = np.atleast_2d(np.asarray(w, dtype=np.float64))
-        return _rmatmul(self.a, np.ascontiguousarray(w), np.zeros((w.shape[0], self.shape[1])))
+        """``W C``: a film operator F (sparse, formed once per term) or the solver's probes
+        (a few dense rows), through their nonzeros, with no double copy of C."""
+        vector = not sp.issparse(w) and np.ndim(w) == 1
+        w = sp.csr_matrix(np.atleast_2d(w) if not sp.issparse(w) else w, dtype=np.float64)
+        out = _csr_rmatmul(w.indptr, w.indices, w.data, self.a, np.zeros((w.shape[0], self.shape[1])))
+        return out[0] if vector else out
 
     def __getitem__(self, key):
         return np.asarray(self.a[key], dtype=np.float64)
@@ -103,21 +103,9 @@ def _matvec(A, x, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)
-def _rmatmul(A, W, out):  # pragma: no cover - compiled
-    """``out = W A`` (W float64, k x m), A float32, sums in float64."""
-    m, n = A.shape
-    for i in range(m):
-        for r in range(W.shape[0]):
-            wi = W[r, i]
-            if wi != 0.0:
-                for j in range(n):
-                    out[r, j] += wi * A[i, j]
-    return out
-
-
-@numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)
 def _csr_rmatmul(indptr, indices, data, A, out):  # pragma: no cover - compiled
-    """``out = W A`` for a CSR ``W`` (float64), A float32, sums in float64."""
+    """``out = W A`` for a CSR ``W`` (float64), A float32, sums in float64: a row of A
+    times each nonzero of W, added into the row of out."""
     for r in range(out.shape[0]):
         for q in range(indptr[r], indptr[r + 1]):
             wi, i = data[q], indices[q]

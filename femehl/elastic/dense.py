@@ -58,7 +58,7 @@ class SingleCompliance:
             if x.shape[0] != self.shape[1]:
                 raise ValueError(f"C @ x: x has {x.shape[0]} entries for {self.shape[1]} columns")
             return _matvec(self.a, x, np.empty(self.shape[0]))
-        return np.column_stack([self @ x[:, j] for j in range(x.shape[1])]).reshape(self.shape[0], -1)
+        return np.column_stack([self @ x[:, j] for j in range(x.shape[1])])
 
     def __rmatmul__(self, w):
         """``W C``: a film operator F (sparse, formed once per term) or the solver's probes
@@ -70,9 +70,6 @@ class SingleCompliance:
 
     def __getitem__(self, key):
         return np.asarray(self.a[key], dtype=np.float64)
-
-    def toarray(self) -> np.ndarray:
-        return self.a.astype(np.float64)
 
 
 @numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)

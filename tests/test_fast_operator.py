@@ -21,7 +21,19 @@ from scipy.special import ellipe
 import femehl
 from femehl.discretize.fe_disk import FEDisc
 from femehl.discretize.fitted import fitted_disk
-from femehl.elastic.hmatrix import FastCompliance, FastOptions, H2Operator, order_for, sampled_error
+from femehl.elastic.hmatrix import (
+    ETA,
+    FastCompliance,
+    FastOptions,
+    H2Operator,
+    _cheb,
+    _grid,
+    _kernel_blocks,
+    _lagrange,
+    _low_rank,
+    order_for,
+    sampled_error,
+)
 from femehl.elastic.kernels import triangle_influence
 from femehl.errors import SceneError
 from femehl.problem.presets import paper_sphere
@@ -122,6 +134,56 @@ def test_truncation_and_order_overrides(sphere):
     for value in ("small", True, [1e-6]):
         with pytest.raises(SceneError, match="operator_tol must be"):
             FastCompliance(disc, value)
+
+
+def _admissible_grids(n, p, seed):
+    """Chebyshev grids of ``n`` random box pairs at the fast operator's admissibility."""
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(-1.0, 1.0, (n, 2))
+    hi = lo + rng.uniform(0.1, 1.0, (n, 2))
+    diam = np.hypot(*(hi - lo).T)
+    angle = rng.uniform(0.0, 2.0 * np.pi, n)
+    # the source box at distance diam / ETA from the target box along a random direction
+    shift = (2.0 * diam + diam / ETA)[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
+    nodes = _cheb(p)
+    return _grid(lo, hi, nodes), _grid(lo + shift, hi + shift, nodes)
+
+
+def test_coupling_kernel_and_interpolation_pieces():
+    """The compiled coupling kernel against 1 / |x - y| written out; the Lagrange basis
+    is 1 at its own node and 0 at the others, and sums to 1 anywhere."""
+    p = 7
+    gt, gs = _admissible_grids(3, p, seed=4)
+    K = _kernel_blocks(gt, gs)
+    b, i, j = 2, 3 * p + 5, 6 * p + 1  # target node (3, 5), source node (6, 1)
+    exact = 1.0 / np.hypot(gt[b, 3, 0] - gs[b, 6, 0], gt[b, 5, 1] - gs[b, 1, 1])
+    assert K[b, i, j] == pytest.approx(exact, rel=1e-15)
+    nodes = _cheb(p)
+    assert np.allclose(_lagrange(nodes, nodes), np.eye(p), atol=1e-14)
+    s = np.linspace(-1.0, 1.0, 101)
+    assert np.allclose(_lagrange(s, nodes).sum(axis=1), 1.0, atol=1e-13)
+
+
+@pytest.mark.parametrize("width", [32, 8], ids=["range-finder", "full-svd-fallback"])
+def test_coupling_compression_bounded_by_the_full_svd(width):
+    """The couplings' random range finder (``_low_rank``): every block's truncation error
+    is at most 1.1 times the full SVD's bound (``tol`` times its largest singular value:
+    the range residual is accepted at 0.1 of it), every block is returned once, and at a
+    width below the blocks' ranks (about 14 at p = 11) the full SVD takes them."""
+    p, tol = 11, 3e-7
+    gt, gs = _admissible_grids(40, p, seed=5)
+    K = _kernel_blocks(gt, gs)
+    s_full = np.linalg.svd(K, compute_uv=False)
+    seen, widths = np.zeros(K.shape[0], int), set()
+    for blocks, u, s, vt in _low_rank(K, tol, width):
+        seen[blocks] += 1
+        widths.add(s.shape[1])
+        for n, b in enumerate(blocks):
+            r = max(1, int((s[n] > tol * s[n, 0]).sum()))
+            err = np.linalg.norm(K[b] - (u[n, :, :r] * s[n, :r]) @ vt[n, :r], 2)
+            assert err <= 1.1 * tol * s_full[b, 0]
+    assert np.all(seen == 1)
+    assert widths == {p * p} if width == 8 else width in widths
 
 
 def test_uniform_pressure_on_a_disk():

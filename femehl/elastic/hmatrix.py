@@ -42,13 +42,37 @@ __all__ = [
 # ---- small pieces -----------------------------------------------------------------------
 def pair_influence(points, tri):
     """Exact ``int_{T_k} dA' / |A_k - x'|`` for paired field points and triangles (k = 0..m-1)."""
-    from femehl.elastic.kernels import _edge_term, _orientation
+    points = np.ascontiguousarray(points, dtype=float)
+    tri = np.ascontiguousarray(tri, dtype=float)
+    k = np.arange(points.shape[0])
+    return _pairs(points, tri, k, k)
 
-    ax, ay = points[:, 0], points[:, 1]
-    acc = _edge_term(ax, ay, tri[:, 0, 0], tri[:, 0, 1], tri[:, 1, 0], tri[:, 1, 1])
-    acc += _edge_term(ax, ay, tri[:, 1, 0], tri[:, 1, 1], tri[:, 2, 0], tri[:, 2, 1])
-    acc += _edge_term(ax, ay, tri[:, 2, 0], tri[:, 2, 1], tri[:, 0, 0], tri[:, 0, 1])
-    return acc * _orientation(tri)
+
+@numba.njit(cache=True, boundscheck=False)
+def _pairs(points, tri, I, J):  # pragma: no cover (compiled)
+    """``int_{T_J[k]} dA' / |A_I[k] - x'|``: the edge terms of ``kernels._edge_term``
+    (arcsinh form, the same cases: an edge through A or of zero length adds nothing),
+    without the gathered copies of the points and triangles."""
+    out = np.empty(I.size)
+    for k in range(I.size):
+        ax, ay = points[I[k], 0], points[I[k], 1]
+        t = tri[J[k]]
+        acc = 0.0
+        for e in range(3):
+            bx, by = t[e, 0], t[e, 1]
+            cx, cy = t[(e + 1) % 3, 0], t[(e + 1) % 3, 1]
+            le = math.hypot(cx - bx, cy - by)
+            if le > 0.0:
+                ex, ey = (cx - bx) / le, (cy - by) / le
+                h = (bx - ax) * ey - (by - ay) * ex
+                ah = abs(h)
+                if ah > 1e-300:
+                    sb = (bx - ax) * ex + (by - ay) * ey
+                    sc = (cx - ax) * ex + (cy - ay) * ey
+                    acc += h * (math.asinh(sc / ah) - math.asinh(sb / ah))
+        cross = (t[1, 0] - t[0, 0]) * (t[2, 1] - t[0, 1]) - (t[1, 1] - t[0, 1]) * (t[2, 0] - t[0, 0])
+        out[k] = acc if cross > 0.0 else (-acc if cross < 0.0 else 0.0)
+    return out
 
 
 def _cheb(p):
@@ -56,14 +80,22 @@ def _cheb(p):
 
 
 def _lagrange(s, nodes):
-    """``l_k(s)`` for scaled coordinates ``s`` (m,) and nodes (p,): (m, p)."""
+    """``l_k(s)`` for scaled coordinates ``s`` (m,) and nodes (p,): (m, p).
+
+    ``prod_{j != k} (s - x_j)`` as the product of the factors before ``k`` and after it
+    (running products both ways): exact at a node too, and p passes instead of p^2."""
     p = nodes.size
-    diff = s[:, None] - nodes[None, :]
-    out = np.empty((s.size, p))
-    for k in range(p):
-        others = np.delete(np.arange(p), k)
-        out[:, k] = np.prod(diff[:, others], axis=1) / np.prod(nodes[k] - nodes[others])
-    return out
+    diff = s[None, :] - nodes[:, None]  # (p, m): rows contiguous
+    before = np.empty_like(diff)
+    after = np.empty_like(diff)
+    before[0] = after[p - 1] = 1.0
+    for k in range(1, p):
+        np.multiply(before[k - 1], diff[k - 1], out=before[k])
+        np.multiply(after[p - k], diff[p - k], out=after[p - 1 - k])
+    denom = np.array([np.prod(nodes[k] - np.delete(nodes, k)) for k in range(p)])
+    before *= after
+    before /= denom[:, None]
+    return before.T
 
 
 def _triangle_rule(degree):
@@ -152,6 +184,48 @@ def cluster_tree(centers, lo_items, hi_items, leaf: int = 32) -> ClusterTree:
     )
 
 
+#: admissible blocks whose couplings are compressed at a time (a chunk's kernel matrices
+#: take FAR_CHUNK x p^4 x 8 bytes: 15 MB at p = 11, reused by the allocator; chunks of
+#: 2,048 blocks, 240 MB fresh each, spent a quarter of the far field's set-up in page
+#: faults on the benchmark machine)
+FAR_CHUNK = 128
+#: columns of the random range finder of the couplings (:func:`_low_rank`) at first, and
+#: the margin kept above the largest rank found: at p = 11 and 3e-7 the ranks are 7-22
+RANGE_WIDTH, RANGE_MARGIN = 32, 10
+
+
+def _low_rank(K, tol, width):
+    """Leading singular triplets of each coupling block ``K[b]`` (n x n), down to ``tol``.
+
+    Yields ``(blocks, u, s, vt)`` (``K[blocks] ~ u diag(s) vt`` with at least the singular
+    values above ``tol * s[:, 0]``).  A random range finder of ``width`` columns (Halko,
+    Martinsson and Tropp 2011, with a fixed seed): ``Q = orth(K Omega)``, the SVD of
+    ``Q^T K`` (width x n).  Its residual ``||K - Q Q^T K||_F`` is computed; a block where it
+    exceeds ``0.1 tol s_0`` gets the full SVD instead.  So every block's truncation error
+    is at most 1.1 times that of its own full SVD, at a quarter of its cost (1.5 ms for
+    121 x 121 on the benchmark machine).
+    """
+    b, n, _ = K.shape
+    if width >= n:
+        u, s, vt = np.linalg.svd(K)
+        yield np.arange(b), u, s, vt
+        return
+    omega = np.random.default_rng(20261206).standard_normal((n, width))
+    Q = np.linalg.qr((K.reshape(-1, n) @ omega).reshape(b, n, width))[0]
+    B = np.matmul(Q.transpose(0, 2, 1), K)
+    R = K - np.matmul(Q, B)
+    residual = np.sqrt(np.einsum("bij,bij->b", R, R))
+    ub, s, vt = np.linalg.svd(B, full_matrices=False)
+    ok = residual <= 0.1 * tol * s[:, 0]
+    good = np.flatnonzero(ok)
+    if good.size:
+        yield good, np.matmul(Q[good], ub[good]), s[good], vt[good]
+    bad = np.flatnonzero(~ok)
+    if bad.size:
+        u, s, vt = np.linalg.svd(K[bad])
+        yield bad, u, s, vt
+
+
 def _box_distance(lo1, hi1, lo2, hi2):
     gap = np.maximum(0.0, np.maximum(lo1 - hi2, lo2 - hi1))
     return np.hypot(gap[:, 0], gap[:, 1])
@@ -191,6 +265,26 @@ def _scaled(x, lo, hi):
     return (2.0 * x - (lo + hi)) / (hi - lo)
 
 
+@numba.njit(cache=True, boundscheck=False)
+def _kernel_blocks(gt, gs):  # pragma: no cover (compiled)
+    """``1 / |x - y|`` between the Chebyshev grids of paired boxes: (blocks, p^2, p^2).
+
+    ``gt``, ``gs`` (blocks, p, 2): each box's nodes per axis; grid point ``a p + b`` is
+    ``(g[a, 0], g[b, 1])`` (the order of the moments and local expansions)."""
+    nb, p = gt.shape[0], gt.shape[1]
+    K = np.empty((nb, p * p, p * p))
+    for k in range(nb):
+        for a in range(p):
+            for b in range(p):
+                i = a * p + b
+                for c in range(p):
+                    dx = gt[k, a, 0] - gs[k, c, 0]
+                    for d in range(p):
+                        dy = gt[k, b, 1] - gs[k, d, 1]
+                        K[k, i, c * p + d] = 1.0 / np.sqrt(dx * dx + dy * dy)
+    return K
+
+
 @numba.njit(cache=True, fastmath={"reassoc", "contract"}, boundscheck=False)
 def _couple(L, Mf, ft, fs, Ut, V):  # pragma: no cover (compiled)
     """``L[ft[b]] += Ut[b]^T (V[b] Mf[fs[b]])`` for every admissible block ``b``.
@@ -213,6 +307,27 @@ def _couple(L, Mf, ft, fs, Ut, V):  # pragma: no cover (compiled)
                 acc += V[b, i, j] * m[j]
             for j in range(k):
                 L[d, j] += Ut[b, i, j] * acc
+
+
+@numba.njit(cache=True, fastmath={"reassoc", "contract"}, boundscheck=False)
+def _couple_columns(L, Mf, ft, fs, Ut, V, blocks):  # pragma: no cover (compiled)
+    """:func:`_couple` of k columns at once (``L``, ``Mf``: clusters x p^2 x k), over the
+    admissible blocks ``blocks`` only (those whose source cluster has moments)."""
+    r, pp, k = V.shape[1], V.shape[2], Mf.shape[2]
+    t = np.empty((r, k))
+    for b in blocks:
+        s, d = fs[b], ft[b]
+        t[:] = 0.0
+        for i in range(r):
+            for a in range(pp):
+                v = V[b, i, a]
+                for j in range(k):
+                    t[i, j] += v * Mf[s, a, j]
+        for i in range(r):
+            for a in range(pp):
+                w = Ut[b, i, a]
+                for j in range(k):
+                    L[d, a, j] += w * t[i, j]
 
 
 # ---- the operator -----------------------------------------------------------------------
@@ -354,7 +469,7 @@ class H2Operator:
             row = T.start[bt][blk] + k // bm[blk]  # position in T.perm
             J = S.perm[S.start[bs][blk] + k % bm[blk]]
             I = T.perm[row]
-            v = pair_influence(targets[I], tri[J])
+            v = _pairs(targets, tri, I, J)
             r0 = int(T.start[bt].min())
             r1 = int((T.start[bt] + T.size[bt]).max())
             M = sp.csr_matrix((v, (row - r0, self.source_element[J])), shape=(r1 - r0, self.n_unknowns))
@@ -443,7 +558,7 @@ class H2Operator:
         return out
 
     def _build_far(self, nodes, ft, fs, svd_tol):
-        p, pp = self.p, self.p * self.p
+        pp = self.p * self.p
         T, S = self.T, self.S
         order = np.argsort(ft, kind="stable")
         ft, fs = ft[order], fs[order]
@@ -451,30 +566,26 @@ class H2Operator:
         gs = _grid(S.lo[fs], S.hi[fs], nodes)
         groups: dict[int, list] = {}  # rank bucket -> [(block index, U, V)] per chunk
         ranks = []
-        chunk = 2048
-        xt = np.stack(np.meshgrid(np.arange(p), np.arange(p), indexing="ij"), -1).reshape(-1, 2)
-        for s in range(0, ft.size, chunk):
-            sl = slice(s, min(s + chunk, ft.size))
-            X = np.stack([gt[sl, xt[:, 0], 0], gt[sl, xt[:, 1], 1]], -1)  # (b, pp, 2)
-            Y = np.stack([gs[sl, xt[:, 0], 0], gs[sl, xt[:, 1], 1]], -1)
-            K = 1.0 / np.hypot(X[:, :, None, 0] - Y[:, None, :, 0], X[:, :, None, 1] - Y[:, None, :, 1])
-            u, sv, vt = np.linalg.svd(K)
-            del K
-            r = np.maximum(1, (sv > svd_tol * sv[:, :1]).sum(axis=1))
-            ranks.append(r)
-            bucket = np.minimum(-(-r // self.rank_step) * self.rank_step, pp)  # blocks grouped by rank
-            for rb in np.unique(bucket):
-                sel = np.flatnonzero(bucket == rb)
-                # U^T (rank x pp) and V (rank x pp): both read along their last axis
-                Ub = (
-                    (u[sel, :, :rb] * sv[sel, None, :rb])
-                    .transpose(0, 2, 1)
-                    .astype(self.factor_dtype, order="C")
-                )
-                groups.setdefault(int(rb), []).append(
-                    (s + sel, Ub, vt[sel, :rb, :].astype(self.factor_dtype))
-                )
-            del u, vt
+        width = min(pp, RANGE_WIDTH)
+        for s in range(0, ft.size, FAR_CHUNK):
+            sl = slice(s, min(s + FAR_CHUNK, ft.size))
+            K = _kernel_blocks(gt[sl], gs[sl])
+            for sel, u, sv, vt in _low_rank(K, svd_tol, width):
+                r = np.maximum(1, (sv > svd_tol * sv[:, :1]).sum(axis=1))
+                ranks.append(r)
+                width = min(pp, max(width, int(r.max()) + RANGE_MARGIN))
+                bucket = np.minimum(-(-r // self.rank_step) * self.rank_step, sv.shape[1])
+                for rb in np.unique(bucket):
+                    i = np.flatnonzero(bucket == rb)
+                    # U^T (rank x pp) and V (rank x pp): both read along their last axis
+                    Ub = (
+                        (u[i, :, :rb] * sv[i, None, :rb])
+                        .transpose(0, 2, 1)
+                        .astype(self.factor_dtype, order="C")
+                    )
+                    groups.setdefault(int(rb), []).append(
+                        (s + sel[i], Ub, vt[i, :rb, :].astype(self.factor_dtype))
+                    )
         ranks = np.concatenate(ranks) if ranks else np.zeros(0, int)
         self._rank_mean = float(ranks.mean()) if ranks.size else 0.0
         self._far_groups = []
@@ -506,8 +617,6 @@ class H2Operator:
     # -- application ----------------------------------------------------------------------
     #: columns per blocked product (a block's moments take n_nodes x p^2 x BLOCK x 8 bytes)
     BLOCK = 32
-    #: admissible blocks per chunk of :meth:`far_block` (their factors in double: 20 MB)
-    CHUNK = 2048
 
     def __matmul__(self, u):
         if sp.issparse(u) or np.ndim(u) == 2:
@@ -525,37 +634,46 @@ class H2Operator:
         u = sp.csc_matrix(u, dtype=float) if sparse else np.asarray(u, dtype=float)
         dense = (lambda a: a.toarray()) if sparse else np.asarray
         out = np.empty((self.T.perm.size, u.shape[1]))
+        work = np.empty((self.n_nodes_S + self.n_nodes_T) * self.p**2 * min(self.BLOCK, u.shape[1]))
         for s in range(0, u.shape[1], self.BLOCK):
             ub = u[:, s : s + self.BLOCK]
-            y = self.far_block(dense(ub))
+            y = self.far_block(ub, work)
             y[self.T.perm] += dense(self._near_perm @ ub)
             out[:, s : s + self.BLOCK] = y
         return out
 
-    def far_block(self, u):
-        """:meth:`far` of the columns of ``u`` (n x k) at once: the same passes, k wide.
+    def far_block(self, u, work=None):
+        """:meth:`far` of the columns of ``u`` (n x k, dense or sparse) at once: the same
+        passes, k wide.  ``work``: a buffer of at least (source + target clusters) x p^2 x
+        k doubles for the moments and local expansions, reused from block to block by
+        :meth:`_columns` (fresh memory costs its page faults, 40 ms a block of 32 columns
+        on 17,678 elements).
 
-        An admissible block whose source cluster has no moment (every column of ``u``
-        vanishes on it: columns of compact support, as a coarse space sorted in space)
-        is skipped: its product is zero.
+        A cluster with no moment (every column of ``u`` vanishes on it: columns of
+        compact support, as a coarse space sorted in space) is skipped in the upward pass
+        and in the couplings: its products are zero.
         """
         p, pp, k = self.p, self.p * self.p, u.shape[1]
-        M = np.asarray(self._P2M @ u).reshape(self.n_nodes_S, p, p, k)
+        if work is None:
+            work = np.empty((self.n_nodes_S + self.n_nodes_T) * pp * k)
+        nM = self.n_nodes_S * pp * k
+        M, L = work[:nM].reshape(-1, k), work[nM : nM + self.n_nodes_T * pp * k].reshape(-1, pp, k)
+        M[...] = 0.0
+        if sp.issparse(u):
+            (self._P2M @ u).toarray(out=M)
+        else:
+            M += self._P2M @ u
+        M = M.reshape(self.n_nodes_S, p, p, k)
+        live = np.any(M.reshape(self.n_nodes_S, -1) != 0.0, axis=1)
         for c, par, wx, wy in self._levels_S:  # M_parent += Wx^T M_child Wy, per column
-            M[par] += np.einsum("nba,nbck,ncd->nadk", wx, M[c], wy, optimize=True)
-        L = np.zeros((self.n_nodes_T, pp * k))
+            m = live[c]  # only the children with moments (a parent's others add zeros)
+            if m.any():
+                M[par[m]] += np.einsum("nba,nbck,ncd->nadk", wx[m], M[c[m]], wy[m], optimize=True)
+                live[par[m]] = True
+        L[...] = 0.0
         Mf = M.reshape(-1, pp, k)
-        live = np.any(Mf != 0.0, axis=(1, 2))
         for ft, fs, Ut, V in self._far_groups:
-            sel = np.flatnonzero(live[fs])
-            for s in range(0, sel.size, self.CHUNK):  # factors in double a chunk at a time
-                b = sel[s : s + self.CHUNK]
-                Vb, Ub = V[b].astype(float, copy=False), Ut[b].astype(float, copy=False)
-                t = np.matmul(Ub.transpose(0, 2, 1), np.matmul(Vb, Mf[fs[b]]))  # (blocks, pp, k)
-                scatter = sp.csr_matrix(
-                    (np.ones(b.size), (ft[b], np.arange(b.size))), shape=(L.shape[0], b.size)
-                )
-                L += scatter @ t.reshape(b.size, pp * k)
+            _couple_columns(L, Mf, ft, fs, Ut, V, np.flatnonzero(live[fs]))
         L = L.reshape(self.n_nodes_T, p, p, k)
         for c, par, wx, wy in reversed(self._levels_T):  # L_child += Wx L_parent Wy^T
             L[c] += np.einsum("nab,nbck,ndc->nadk", wx, L[par], wy, optimize=True)

@@ -56,7 +56,7 @@ ORDER = 2
 #: substrate whose elastic operator is dense only (``operators = ("dense",)``: a layer)
 MAX_ELEMENTS = 25_000
 #: ... on a substrate with the fast hierarchical operator (the half space, compressible
-#: or not; a viscoelastic one relaxing it), used by the FE method from 12,000 elements
+#: or not; a viscoelastic one relaxing it), used by the FE method from 9,500 elements
 #: on: its memory grows like the cells (20 kB each) and a step costs about 1 s at
 #: 89,000 cells (``benchmarks/fast_operator.md``), so this is a cost budget, not a
 #: memory limit

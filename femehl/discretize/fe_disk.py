@@ -56,11 +56,13 @@ FITTED = "fitted"
 #: "auto" uses the fast operator from this many elements on (or when the dense one does
 #: not fit in memory): the measured crossover of the whole paper case (set-up and steps,
 #: BDF2 at dt = 0.01, one BLAS thread, each path in its own process, in turn;
-#: ``benchmarks/fast_operator.py crossover``).  With the dense ``C`` in single precision
-#: (:mod:`femehl.elastic.dense`, feabb35): fast / dense 1.44 at 7,998 elements, 1.12 at
-#: 11,450, 0.90 at 14,112 (medians of 2; ratio 1 near 12,700).  Before it (6a7a811, double
-#: precision): 1.15 at 5,766, 0.90 at 7,998, 0.67 at 11,450, and the crossover was 8,000.
-FAST_CROSSOVER = 12_000
+#: ``benchmarks/fast_operator.py crossover``).  With the fast operator's set-up halved
+#: (de6fc71): fast / dense 1.11 at 7,998 elements, 0.85 at 11,450 (medians of 2; ratio 1
+#: near 9,400).  With the dense ``C`` in single precision (:mod:`femehl.elastic.dense`,
+#: feabb35) and the former set-up: 1.44 at 7,998, 1.12 at 11,450, 0.90 at 14,112 (ratio 1
+#: near 12,700, the crossover 12,000).  Before it (6a7a811, double precision): 1.15 at
+#: 5,766, 0.90 at 7,998, 0.67 at 11,450, and the crossover was 8,000.
+FAST_CROSSOVER = 9_500
 
 
 def _horizon(scene) -> float:

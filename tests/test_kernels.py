@@ -267,6 +267,28 @@ def test_mesh_edge_terms_reproduce_triangle_influence(random_mesh):
     assert np.all(triangle_influence(P, tri) >= 0)
 
 
+@pytest.mark.parametrize("gap", [1e-6, 1e-9, 1e-13])
+def test_points_a_hair_from_an_edge(gap):
+    """A field point ``gap`` from the inside of an edge: the compiled edge terms (dense
+    rows and the fast operator's near pairs) against the arcsinh form of
+    ``triangle_influence``, which has no cancellation there (``asinh`` is odd, so it adds
+    two positive terms).  The former log form computed ``s_B + rho_B = 0`` in double from
+    a gap of about 1e-8 of the edge on (a division by zero): now each factor is in the
+    form that adds positives, and the three agree to round-off."""
+    from femehl.elastic.hmatrix import pair_influence
+
+    P = np.array([[0.0, 0.0], [1.0, 0.0], [0.3, 0.8]])
+    t = np.array([[0], [1], [2]])
+    tri = P[t.T]  # (1, 3, 2)
+    A = np.array([[0.5, gap], [0.5, -gap], [0.02, 0.5 * gap]])
+    want = triangle_influence(A, tri)[:, 0]
+    edges, S = mesh_edges(t, P)
+    dense = np.asarray((S.T @ edge_terms(A, P, edges).T).T)[:, 0]
+    near = pair_influence(A, np.repeat(tri, A.shape[0], axis=0))
+    np.testing.assert_allclose(dense, want, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(near, want, rtol=1e-13, atol=0)
+
+
 def test_edge_terms_mirror_is_the_mirrored_edges_subtracted(random_mesh):
     """``mirror=True`` (a half disk's image, seen from A mirrored) equals the terms of the
     edges mirrored in y = 0 subtracted, to round-off; and S^T T is then the influence of

@@ -19,6 +19,7 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
+from femehl.elastic.kernels import _edge_log
 from femehl.validation import (
     check_admissibility,
     check_chebyshev_order,
@@ -50,26 +51,28 @@ def pair_influence(points, tri):
 
 @numba.njit(cache=True, boundscheck=False)
 def _pairs(points, tri, I, J):  # pragma: no cover (compiled)
-    """``int_{T_J[k]} dA' / |A_I[k] - x'|``: the edge terms of ``kernels._edge_term``
-    (arcsinh form, the same cases: an edge through A or of zero length adds nothing),
-    without the gathered copies of the points and triangles."""
+    """``int_{T_J[k]} dA' / |A_I[k] - x'|`` without gathered copies of the points and
+    triangles: the edge terms of the dense operator (``kernels._edge_log``,
+    nothing from an edge through A or of zero length), the three vertex distances shared."""
     out = np.empty(I.size)
+    rho = np.empty(3)
     for k in range(I.size):
         ax, ay = points[I[k], 0], points[I[k], 1]
         t = tri[J[k]]
+        for v in range(3):
+            rho[v] = math.sqrt((t[v, 0] - ax) ** 2 + (t[v, 1] - ay) ** 2)
         acc = 0.0
         for e in range(3):
-            bx, by = t[e, 0], t[e, 1]
-            cx, cy = t[(e + 1) % 3, 0], t[(e + 1) % 3, 1]
-            le = math.hypot(cx - bx, cy - by)
+            f = (e + 1) % 3
+            bx, by = t[e, 0] - ax, t[e, 1] - ay
+            ex, ey = t[f, 0] - t[e, 0], t[f, 1] - t[e, 1]
+            le = math.sqrt(ex * ex + ey * ey)
             if le > 0.0:
-                ex, ey = (cx - bx) / le, (cy - by) / le
-                h = (bx - ax) * ey - (by - ay) * ex
-                ah = abs(h)
-                if ah > 1e-300:
-                    sb = (bx - ax) * ex + (by - ay) * ey
-                    sc = (cx - ax) * ex + (cy - ay) * ey
-                    acc += h * (math.asinh(sc / ah) - math.asinh(sb / ah))
+                ex, ey = ex / le, ey / le
+                h = bx * ey - by * ex
+                if abs(h) > 1e-14 * le:
+                    sb = bx * ex + by * ey
+                    acc += _edge_log(h, sb, sb + le, rho[e], rho[f])
         cross = (t[1, 0] - t[0, 0]) * (t[2, 1] - t[0, 1]) - (t[1, 1] - t[0, 1]) * (t[2, 0] - t[0, 0])
         out[k] = acc if cross > 0.0 else (-acc if cross < 0.0 else 0.0)
     return out

@@ -259,6 +259,18 @@ def _edge_frames(nodes, B, C):  # pragma: no cover - compiled
     return frame
 
 
+@numba.njit(cache=True, inline="always")
+def _edge_log(h, sb, sc, rho_b, rho_c):  # pragma: no cover - compiled
+    """An edge B -> C seen from A: ``h log((s_C + rho_C) / (s_B + rho_B))``, ``h`` the signed
+    distance of A from the edge's line, ``s`` the vertices' positions along it from A's
+    foot, ``rho`` their distances from A.  Each factor in the form that adds two positive
+    numbers (``s + rho = h^2 / (rho - s)``): no cancellation wherever the foot lies (the
+    difference of two arcsinh lost up to 4e-10 relative near an edge's line)."""
+    num = sc + rho_c if sc >= 0.0 else h * h / (rho_c - sc)
+    den = sb + rho_b if sb >= 0.0 else h * h / (rho_b - sb)
+    return h * math.log(num / den)
+
+
 @numba.njit(cache=True, boundscheck=False)
 def _edge_row(ax, ay, nodes, B, C, frame, mirror, rho, row):  # pragma: no cover - compiled
     """``row[k]``: the term of edge k seen from A = (ax, ay), minus the mirrored edge's
@@ -280,11 +292,7 @@ def _edge_row(ax, ay, nodes, B, C, frame, mirror, rho, row):  # pragma: no cover
             h = bx * ey[k] - by * ex[k]  # signed distance of A from the edge's line
             if abs(h) > 1e-14 * le[k]:
                 sb = bx * ex[k] + by * ey[k]  # positions of B and C along the edge from A's foot
-                sc = sb + le[k]
-                if sb + sc < 0.0:  # the foot beyond C: the mirror form, no cancellation
-                    val += h * math.log((rho[m, B[k]] - sb) / (rho[m, C[k]] - sc))
-                else:
-                    val += h * math.log((sc + rho[m, C[k]]) / (sb + rho[m, B[k]]))
+                val += _edge_log(h, sb, sb + le[k], rho[m, B[k]], rho[m, C[k]])
         row[k] = val
 
 

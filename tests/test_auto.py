@@ -317,7 +317,15 @@ def test_the_next_run_aims_space_and_time_at_their_shares():
     RATIO_MIN to RATIO_MAX finer when short in space, else the same; the time tolerance in
     proportion for TIME_SHARE SAFETY tol, within TAU_STEP (never loosened); no estimate:
     RATIO_MAX times finer in both."""
-    from femehl.accuracy.auto import RATIO_MAX, RATIO_MIN, SAFETY, TAU_STEP, TIME_SHARE, _next_run
+    from femehl.accuracy.auto import (
+        RATIO_MAX,
+        RATIO_MAX_ADAPTED,
+        RATIO_MIN,
+        SAFETY,
+        TAU_STEP,
+        TIME_SHARE,
+        _next_run,
+    )
 
     def est(space, slow):
         z = np.zeros(2)
@@ -336,6 +344,12 @@ def test_the_next_run_aims_space_and_time_at_their_shares():
     assert level == pytest.approx(1 / RATIO_MIN) and RATIO_MIN == 1.2
     unknown = _next_run(1.0, 1e-3, None, tol)
     assert unknown == (pytest.approx(1 / RATIO_MAX), pytest.approx(1e-3 / RATIO_MAX**2))
+    # after a run on adapted meshes the order-2 aim goes up to RATIO_MAX_ADAPTED: the paper
+    # case at tol 1e-3 asked 3.26 from its second run (held at 2.83, a run fell short)
+    asked = est(3.26**2 * (1 - TIME_SHARE) * aim, 0.0)
+    assert _next_run(1.0, 1e-3, asked, tol)[0] == pytest.approx(1 / RATIO_MAX)
+    assert _next_run(1.0, 1e-3, asked, tol, RATIO_MAX_ADAPTED)[0] == pytest.approx(1 / 3.26)
+    assert _next_run(1.0, 1e-3, est(1e3 * aim, 0.0), tol, RATIO_MAX_ADAPTED)[0] == pytest.approx(0.25)
 
 
 def test_budget_stops_with_a_warning(caplog):

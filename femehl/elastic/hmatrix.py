@@ -661,11 +661,11 @@ class H2Operator:
             work = np.empty((self.n_nodes_S + self.n_nodes_T) * pp * k)
         nM = self.n_nodes_S * pp * k
         M, L = work[:nM].reshape(-1, k), work[nM : nM + self.n_nodes_T * pp * k].reshape(-1, pp, k)
-        M[...] = 0.0
         if sp.issparse(u):
+            M[...] = 0.0  # toarray(out=) adds into it
             (self._P2M @ u).toarray(out=M)
         else:
-            M += self._P2M @ u
+            M[...] = self._P2M @ u
         M = M.reshape(self.n_nodes_S, p, p, k)
         live = np.any(M.reshape(self.n_nodes_S, -1) != 0.0, axis=1)
         for c, par, wx, wy in self._levels_S:  # M_parent += Wx^T M_child Wy, per column

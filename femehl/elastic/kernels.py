@@ -265,7 +265,8 @@ def _edge_log(h, sb, sc, rho_b, rho_c):  # pragma: no cover - compiled
     distance of A from the edge's line, ``s`` the vertices' positions along it from A's
     foot, ``rho`` their distances from A.  Each factor in the form that adds two positive
     numbers (``s + rho = h^2 / (rho - s)``): no cancellation wherever the foot lies (the
-    difference of two arcsinh lost up to 4e-10 relative near an edge's line)."""
+    former form, ``s + rho`` as it comes, lost up to 4e-10 relative near an edge's line
+    and divided by zero a hair from the inside of an edge)."""
     num = sc + rho_c if sc >= 0.0 else h * h / (rho_c - sc)
     den = sb + rho_b if sb >= 0.0 else h * h / (rho_b - sb)
     return h * math.log(num / den)

@@ -121,17 +121,26 @@ def test_the_history_is_drawn_once_with_the_estimate(tmp_path, monkeypatch):
     assert len(drawn) == 1 and drawn[0], drawn  # one drawing, with the error columns
     assert (folder / "history.png").stat().st_size > 10_000
 
-    replays, calls = auto.replays, []
+    from femehl.accuracy import companions
 
-    def interrupted(*args, **kwargs):  # Ctrl-C in the written candidate's companions
-        calls.append(1)
-        if len(calls) > 1:
-            raise KeyboardInterrupt
-        return replays(*args, **kwargs)  # the first run's (in memory)
+    ways = [("serial", auto, "replays")]  # the companions replay after the run
+    if companions.concurrent():  # ... or beside it
+        ways.append(("auto", companions.Companions, "results"))
+    for where, owner, name in ways:
+        monkeypatch.setenv(companions.ENV, where)
+        real, calls = getattr(owner, name), []
 
-    drawn.clear()
-    monkeypatch.setattr(auto, "replays", interrupted)
-    folder = tmp_path / "cut"
-    with pytest.raises(KeyboardInterrupt):
-        run_to_folder(SCENE, folder, **RUN)
-    assert len(drawn) == 1 and not drawn[0] and (folder / "history.png").stat().st_size > 10_000
+        def interrupted(*args, real=real, calls=calls, **kwargs):  # Ctrl-C in the candidate's companions
+            calls.append(1)
+            if len(calls) > 1:
+                raise KeyboardInterrupt
+            return real(*args, **kwargs)  # the first run's (in memory)
+
+        drawn.clear()
+        monkeypatch.setattr(owner, name, interrupted)
+        folder = tmp_path / f"cut_{name}"
+        with pytest.raises(KeyboardInterrupt):
+            run_to_folder(SCENE, folder, **RUN)
+        assert len(drawn) == 1 and not drawn[0] and (folder / "history.png").stat().st_size > 10_000
+        monkeypatch.undo()
+        monkeypatch.setattr(plots, "history_png", counted)

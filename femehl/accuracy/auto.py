@@ -14,6 +14,7 @@ every constant: docs/design.md section 9.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import itertools
 import logging
@@ -21,6 +22,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -379,16 +381,23 @@ def replays(stepper, run, dt: float | None = None) -> tuple:
     try:
         out = tuple(run_loop(stepper, t_end, store_every=0, **plan) for plan in plans)
     except SolverError as exc:
-        logger.warning("femehl: no error estimate: the coarser companion run stopped (%s)", exc)
+        _stopped(exc)
         return None, None
-    cut = sum(getattr(plan.get("steps"), "cut", 0) for plan in plans)
+    _cut(sum(getattr(plan.get("steps"), "cut", 0) for plan in plans))
+    return out
+
+
+def _stopped(why) -> None:
+    logger.warning("femehl: no error estimate: the coarser companion run stopped (%s)", why)
+
+
+def _cut(cut: int) -> None:
     if cut:
         logger.warning(
             "femehl: the companions cut %d of the run's steps in two (a step failed on their coarser "
             "mesh): their estimate there holds a time error too",
             cut,
         )
-    return out
 
 
 def one_run_estimate(run, full: Result, half: Result, ratio: float, order: int = 2, levels=()) -> Estimate:
@@ -474,6 +483,7 @@ def _run(
     plan=None,
     deadline=None,
     progress=None,
+    watch=None,
 ) -> Result:
     """One adaptive run at ``level`` (its discretization from ``ladder``) to the time
     tolerance ``tol_t``, through the one loop (:func:`femehl.solver.loop.run_scene`).
@@ -482,12 +492,14 @@ def _run(
     it) is written into ``folder`` (a :class:`~femehl.output.run.RunFolder`, if any) as it
     goes, and always finishes; the others run in memory, and one still going at
     ``deadline`` (``time.perf_counter()``) raises :class:`_OutOfTime`.  ``progress(desc,
-    t_end, t_start)``, when given, makes a State handler with a ``close()`` (a progress bar).
+    t_end, t_start)``, when given, makes a State handler with a ``close()`` (a progress bar);
+    ``watch``, a State handler that follows the run (its companions).
     """
-    from femehl.solver.loop import run_scene
+    from femehl.solver.loop import chain, run_scene
 
     t0 = time.perf_counter()
     disc, on_state, controls = _discretization(ladder, scene, t_end, level, options)
+    on_state = chain([watch, on_state])
     sink = None if plan is None else folder
     if sink is None and deadline is not None:
         on_state = _deadline_guard(deadline, on_state)
@@ -519,25 +531,80 @@ def _run(
     return res
 
 
-def _estimate(scene, method, ladder, t_end, level, options, run) -> Estimate | None:
-    """``run``'s estimate from its companions (:func:`replays`) at :data:`COMPANION_RATIO`
-    times its ``level`` on ``ladder`` (None, logged, when they stop); their wall time in
-    ``run.info["estimate_wall"]``.  ``run`` has ``t``, the :data:`QUANTITIES` and ``info``."""
-    from femehl.errors import MeshError
+def _companion_maker(scene, method, ladder, t_end, level_c, options):
+    """What builds the companions' stepper: the run's discretization at ``level_c``."""
     from femehl.solver.loop import make_stepper
 
+    return lambda: make_stepper(scene, method, **_discretization(ladder, scene, t_end, level_c, options)[0])
+
+
+def _companions(scene, method, ladder, t_end, level, options):
+    """The companions of a run at ``level``, started beside it (:mod:`femehl.accuracy.companions`),
+    or a do-nothing context where they replay after it."""
+    from femehl.accuracy.companions import Companions, concurrent
+
+    if not concurrent():
+        return contextlib.nullcontext()
+    make = _companion_maker(scene, method, ladder, t_end, COMPANION_RATIO * level, options)
+    try:
+        return Companions(make, t_end, breakpoints_of(scene))
+    except OSError as exc:  # no process to be had (limits, memory): they replay after the run
+        logger.info("femehl: the companions cannot run beside the run (%s): they replay after it", exc)
+        return contextlib.nullcontext()
+
+
+def _replayed_on(run, got) -> bool:
+    """Whether the companions beside ``run`` landed on its steps and on every other one."""
+    plans = (run.t[1:], every_other_step(run.t, breakpoints_of(getattr(run, "scene", None))))
+    return all(np.isin(ts, r.t).all() for ts, r in zip(plans, (got.full, got.half), strict=True))
+
+
+def _replay_now(make, run):
+    """The companions' :class:`~femehl.accuracy.companions.Replayed`, replayed after ``run``."""
+    from femehl.accuracy.companions import Replayed
+    from femehl.errors import MeshError
+
+    try:
+        stepper = make()
+    except MeshError as exc:  # a mesh this coarse may not be made
+        return Replayed(stopped=("MeshError", str(exc)))
+    full, half = replays(stepper, run)  # logs a stop and the steps cut
+    return Replayed(
+        full, half, stepper.scheme.order, stopped=None if full is not None else ("SolverError", "logged")
+    )
+
+
+def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) -> Estimate | None:
+    """``run``'s estimate from its companions at :data:`COMPANION_RATIO` times its ``level``
+    on ``ladder`` (None, logged, when they stop): from ``beside`` (a
+    :class:`~femehl.accuracy.companions.Companions` that followed the run), or replayed now
+    (:func:`replays`); the wall time this adds after the run in ``run.info["estimate_wall"]``.
+    ``run`` has ``t``, the :data:`QUANTITIES` and ``info``."""
     t0 = time.perf_counter()
     level_c = COMPANION_RATIO * level
-    try:
-        stepper = make_stepper(scene, method, **_discretization(ladder, scene, t_end, level_c, options)[0])
-    except MeshError as exc:  # a mesh this coarse may not be made
-        logger.warning("femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, exc)
-        return None
-    full, half = replays(stepper, run)
+    got = None if beside is None else beside.results()
+    if got is not None and got.stopped is None:
+        got.full.scene = got.half.scene = scene
+        if _replayed_on(run, got):
+            _cut(got.cut)
+        else:
+            logger.info(
+                "femehl: the companions beside the run missed some of its steps: they replay after it"
+            )
+            got = None
+    elif got is not None and got.stopped[0] != "MeshError":
+        _stopped(got.stopped[1])
+    if got is None:
+        got = _replay_now(_companion_maker(scene, method, ladder, t_end, level_c, options), run)
     run.info["estimate_wall"] = time.perf_counter() - t0
-    if full is None:
+    if got.stopped is not None:
+        if got.stopped[0] == "MeshError":
+            logger.warning(
+                "femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, got.stopped[1]
+            )
         return None
-    est = one_run_estimate(run, full, half, COMPANION_RATIO, stepper.scheme.order, (level, level_c))
+    full, half = got.full, got.half
+    est = one_run_estimate(run, full, half, COMPANION_RATIO, got.order, (level, level_c))
     logger.info(
         "auto: estimated error %.3g (space %.3g, time %.3g; %s) from companions at level %.3g, %.1f s",
         est.worst(),
@@ -560,8 +627,6 @@ def resume_to_tolerance(scene, folder, saved: dict, *, t_end, method, store_ever
     goes on in ``folder`` on the mesh it was made on (fitted to the run's first ``t_end``,
     or adapted); the budgets of the sequence no longer apply.  Its companions then replay
     the whole run's steps (from the folder's summary) for its estimate."""
-    from types import SimpleNamespace
-
     from femehl.output.table import read_summary
 
     kept = {k: v for k, v in options.items() if k not in ("max_wall", "max_elements")}
@@ -814,69 +879,71 @@ def solve_to_tolerance(
         # the first run, when meshes are then adapted to it: in memory, not the answer
         seeds = not runs and ladder.adapt is not None
         plan = None if seeds else _plan(tol, level, tol_t, t_end, ladder)
-        try:
-            res = _run(
-                scene,
-                method,
-                ladder,
-                t_end,
-                level,
-                tol_t,
-                1 if seeds else store_every,  # the run meshes are adapted to: all its states
-                options,
-                folder,
-                plan,
-                deadline,
-                progress,
-            )
-        except _OutOfTime as exc:
-            stopped = "time budget"
-            if not runs:
-                raise TimeBudgetError(
-                    f"no run finished within max_wall = {max_wall:g} s: the first, at level {level:.3g} "
-                    f"(~{cells(level):.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. Give a larger "
-                    "max_wall, or a coarser first level (level=).",
-                    t=exc.t,
-                ) from None
-            logger.warning(
-                "auto: max_wall = %g s reached at t = %.4g of the run at level %.3g: it is abandoned, "
-                "the answer is the last finished run",
-                max_wall,
-                exc.t,
-                level,
-            )
-            break
-        except SolverError as exc:
-            if getattr(exc, "where", None) is None:
-                raise  # not a film that closes or a step floor: nothing a finer mesh changes
-            if adapted_at is not None and _stalled(exc):  # the adapted meshes, not the film
-                logger.warning(
-                    "auto: the run on meshes adapted to the first stopped at the step floor with a "
-                    "film that was not closing (%s): the scene-fitted meshes go on",
-                    exc,
+        with _companions(scene, method, ladder, t_end, level, options) as beside:
+            try:
+                res = _run(
+                    scene,
+                    method,
+                    ladder,
+                    t_end,
+                    level,
+                    tol_t,
+                    1 if seeds else store_every,  # the run meshes are adapted to: all its states
+                    options,
+                    folder,
+                    plan,
+                    deadline,
+                    progress,
+                    beside,
                 )
-                ladder, adapted_at = fitted, None
-                cells = ladder.cells_of(scene, t_end)
-                continue
-            if runs and _stalled(exc):  # a finer mesh stalls sooner: halfway to the last run
-                between = math.sqrt(float(runs[-1].info["level"]) * level)
-                if between < float(runs[-1].info["level"]) / BUDGET_RATIO:
-                    logger.warning(
-                        "auto: the run at level %.3g stopped at the step floor with a film that was "
-                        "not closing (%s): level %.3g, halfway to the last finished run, goes on",
-                        level,
-                        exc,
-                        between,
-                    )
-                    level = between
-                    continue
-                stopped = "step floor"
+            except _OutOfTime as exc:
+                stopped = "time budget"
+                if not runs:
+                    raise TimeBudgetError(
+                        f"no run finished within max_wall = {max_wall:g} s: the first, at level "
+                        f"{level:.3g} (~{cells(level):.0f} cells), had reached t = {exc.t:.4g} of {t_end:g}. "
+                        "Give a larger max_wall, or a coarser first level (level=).",
+                        t=exc.t,
+                    ) from None
+                logger.warning(
+                    "auto: max_wall = %g s reached at t = %.4g of the run at level %.3g: it is abandoned, "
+                    "the answer is the last finished run",
+                    max_wall,
+                    exc.t,
+                    level,
+                )
                 break
-            failed = _closing_confirmed(failed, exc, level, t_end)
-            level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
-            tol_t = min(tol_t, time_tolerance(level))
-            continue
-        est = _estimate(scene, method, ladder, t_end, level, options, res)
+            except SolverError as exc:
+                if getattr(exc, "where", None) is None:
+                    raise  # not a film that closes or a step floor: nothing a finer mesh changes
+                if adapted_at is not None and _stalled(exc):  # the adapted meshes, not the film
+                    logger.warning(
+                        "auto: the run on meshes adapted to the first stopped at the step floor with a "
+                        "film that was not closing (%s): the scene-fitted meshes go on",
+                        exc,
+                    )
+                    ladder, adapted_at = fitted, None
+                    cells = ladder.cells_of(scene, t_end)
+                    continue
+                if runs and _stalled(exc):  # a finer mesh stalls sooner: halfway to the last run
+                    between = math.sqrt(float(runs[-1].info["level"]) * level)
+                    if between < float(runs[-1].info["level"]) / BUDGET_RATIO:
+                        logger.warning(
+                            "auto: the run at level %.3g stopped at the step floor with a film that was "
+                            "not closing (%s): level %.3g, halfway to the last finished run, goes on",
+                            level,
+                            exc,
+                            between,
+                        )
+                        level = between
+                        continue
+                    stopped = "step floor"
+                    break
+                failed = _closing_confirmed(failed, exc, level, t_end)
+                level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
+                tol_t = min(tol_t, time_tolerance(level))
+                continue
+            est = _estimate(scene, method, ladder, t_end, level, options, res, beside)
         err = math.nan if est is None else est.worst()
         if fine is not None:
             fine._stored.clear()  # superseded: its scalars stay, its fields go

@@ -36,7 +36,7 @@ def _make():
 
 def _beside(run, make=_make):
     """Feed ``run``'s states (its times) to companions as the run would, and collect them."""
-    with comp.Companions(make, T_END, breakpoints_of(SCENE)) as beside:
+    with comp.Companions(make, T_END, breakpoints_of(SCENE), REPLAY_HALVINGS) as beside:
         for t in run.t:
             beside(type("S", (), {"t": t}))
         return beside.results()

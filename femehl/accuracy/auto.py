@@ -547,7 +547,7 @@ def _companions(scene, method, ladder, t_end, level, options):
         return contextlib.nullcontext()
     make = _companion_maker(scene, method, ladder, t_end, COMPANION_RATIO * level, options)
     try:
-        return Companions(make, t_end, breakpoints_of(scene))
+        return Companions(make, t_end, breakpoints_of(scene), REPLAY_HALVINGS)
     except OSError as exc:  # no process to be had (limits, memory): they replay after the run
         logger.info("femehl: the companions cannot run beside the run (%s): they replay after it", exc)
         return contextlib.nullcontext()

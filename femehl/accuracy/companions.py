@@ -127,10 +127,10 @@ class _Times:
                 i = 0
 
 
-def _child(make, t_end, breaks, every_other, fd, conn):
-    """A companion: build its stepper (``make()``), replay the times from ``fd``, send
-    ``(outcome, ...)`` on ``conn``; silent when the run was abandoned."""
-    from femehl.accuracy.auto import REPLAY_HALVINGS
+def _child(make, t_end, breaks, halvings, every_other, fd, conn):
+    """A companion: build its stepper (``make()``), replay the times from ``fd`` (a failed
+    step cut in two up to ``halvings`` times), send ``(outcome, ...)`` on ``conn``; silent
+    when the run was abandoned."""
     from femehl.solver.loop import run_loop
     from femehl.solver.threads import limited
 
@@ -141,7 +141,7 @@ def _child(make, t_end, breaks, every_other, fd, conn):
     try:
         with limited():
             stepper = make()
-            steps = _Streamed(iter(times), halvings=REPLAY_HALVINGS)
+            steps = _Streamed(iter(times), halvings=halvings)
             res = run_loop(stepper, t_end, store_every=0, steps=steps)
         if times.finished:
             res.scene = res.disc = None  # the parent has both; a user's shape may not pickle
@@ -160,13 +160,15 @@ def _child(make, t_end, breaks, every_other, fd, conn):
 class Companions:
     """The companions of one run, replaying its accepted times as they come.
 
-    ``make()`` builds their stepper (in each process); ``t_end`` is the run's end and
-    ``breaks`` the motion's breakpoints.  Call the object with every accepted State of the
-    run (it is a State handler), then :meth:`results`; use it as a context manager so that
-    the processes end with the run whatever happens.
+    ``make()`` builds their stepper (in each process); ``t_end`` is the run's end,
+    ``breaks`` the motion's breakpoints, ``halvings`` how many times a step that fails on
+    their mesh may be cut in two (:class:`~femehl.solver.stepping.GivenSteps`).  Call the
+    object with every accepted State of the run (it is a State handler), then
+    :meth:`results`; use it as a context manager so that the processes end with the run
+    whatever happens.
     """
 
-    def __init__(self, make, t_end: float, breaks=()):
+    def __init__(self, make, t_end: float, breaks=(), halvings: int = 0):
         ctx = multiprocessing.get_context("fork")
         self._procs = []
         with warnings.catch_warnings():  # Python >= 3.12 warns of fork beside BLAS's idle threads
@@ -176,7 +178,9 @@ class Companions:
                 recv, send = ctx.Pipe(duplex=False)
                 _OPEN.add(w)
                 proc = ctx.Process(
-                    target=_child, args=(make, float(t_end), tuple(breaks), every_other, r, send), daemon=True
+                    target=_child,
+                    args=(make, float(t_end), tuple(breaks), halvings, every_other, r, send),
+                    daemon=True,
                 )
                 proc.start()
                 os.close(r)

@@ -880,22 +880,10 @@ def solve_to_tolerance(
         seeds = not runs and ladder.adapt is not None
         plan = None if seeds else _plan(tol, level, tol_t, t_end, ladder)
         with _companions(scene, method, ladder, t_end, level, options) as beside:
+            keep = 1 if seeds else store_every  # the run meshes are adapted to: all its states
+            sinks = (folder, plan, deadline, progress, beside)
             try:
-                res = _run(
-                    scene,
-                    method,
-                    ladder,
-                    t_end,
-                    level,
-                    tol_t,
-                    1 if seeds else store_every,  # the run meshes are adapted to: all its states
-                    options,
-                    folder,
-                    plan,
-                    deadline,
-                    progress,
-                    beside,
-                )
+                res = _run(scene, method, ladder, t_end, level, tol_t, keep, options, *sinks)
             except _OutOfTime as exc:
                 stopped = "time budget"
                 if not runs:

@@ -4,7 +4,8 @@
 accepted time goes down a pipe to two forked processes, one replaying every step on the
 companions' coarser mesh, one every other step, so the estimate is ready when the run
 ends.  Where processes cannot be forked (:func:`concurrent`) or one fails, the caller
-replays after the run (:func:`femehl.accuracy.auto.replays`), with the same result.
+replays after the run (:func:`femehl.accuracy.auto.replays`), with the same result to the
+linear solver's tolerance.
 """
 
 from __future__ import annotations

@@ -75,13 +75,35 @@ def test_a_companion_that_fails_hands_over(caplog):
     assert "RuntimeError: out of memory, say" in caplog.text
 
 
+def test_a_companion_that_hangs_hands_over(caplog):
+    """A companion with no answer within ``wait`` of the run's end (a lock held across the
+    fork, say) is ended, and the estimate is replayed after the run."""
+    import time
+
+    def hung():
+        time.sleep(60)
+
+    run = _run()
+    with comp.Companions(hung, T_END, breakpoints_of(SCENE), REPLAY_HALVINGS) as beside:
+        for t in run.t:
+            beside(type("S", (), {"t": t}))
+        pids = [p["pid"] for p in beside._procs]
+        t0 = time.perf_counter()
+        with caplog.at_level(logging.INFO, logger="femehl"):
+            assert beside.results(wait=1.0) is None
+    assert time.perf_counter() - t0 < 10.0 and "no answer within 1 s" in caplog.text
+    for pid in pids:  # ended and reaped
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+
+
 def test_they_end_with_a_run_that_stops():
     """A run that stops (a film that closes, Ctrl-C, max_wall) ends its companions and
     closes their pipes: no process and no descriptor is left behind."""
     fds = len(os.listdir("/proc/self/fd"))
     with pytest.raises(KeyboardInterrupt), comp.Companions(_make, T_END) as beside:
         beside(type("S", (), {"t": 0.0}))
-        pids = [p["proc"].pid for p in beside._procs]
+        pids = [p["pid"] for p in beside._procs]
         raise KeyboardInterrupt
     for pid in pids:  # ended and reaped
         with pytest.raises(ProcessLookupError):
@@ -92,17 +114,19 @@ def test_they_end_with_a_run_that_stops():
 
 def test_the_automatic_mode_gives_the_same_answer_either_way(monkeypatch):
     """The automatic sequence with its companions beside the runs, and replayed after them
-    (FEMEHL_COMPANIONS=serial): the same runs and estimates to the linear solver's
-    tolerance (after the run, the half-step replay starts on the full replay's warmed
-    preconditioner, beside it on a fresh one)."""
+    (FEMEHL_COMPANIONS=serial): the same runs, and the estimates within 1e-5 of each other
+    (measured 7.5e-7: after the run the half-step replay starts on the full replay's warmed
+    preconditioner, beside it on a fresh one, and each solve stops at its own tolerance)."""
     scene = femehl.presets.paper_sphere()
     beside = femehl.solve(scene, t_end=0.05, tol=3e-2, store_every=0)
     monkeypatch.setenv(comp.ENV, "serial")
     after = femehl.solve(scene, t_end=0.05, tol=3e-2, store_every=0)
-    assert beside.info["auto"]["elements"] == after.info["auto"]["elements"]
+    for key in ("elements", "steps", "levels"):
+        assert beside.info["auto"][key] == after.info["auto"][key]
     for q in ("load", "film_center", "film_min"):
+        assert np.array_equal(getattr(beside, q), getattr(after, q))
         a, b = beside.estimate.errors[q]["total"], after.estimate.errors[q]["total"]
-        assert a.shape == b.shape and np.max(np.abs(a - b)) <= 1e-3 * np.max(b)
+        assert a.shape == b.shape and np.max(np.abs(a - b)) <= 1e-5 * np.max(b)
 
 
 def test_the_switch_is_checked(monkeypatch):

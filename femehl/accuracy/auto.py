@@ -360,15 +360,17 @@ def every_other_step(times, breaks=()) -> list[float]:
     return [float(t[i]) for i in keep]
 
 
-def replays(stepper, run, dt: float | None = None) -> tuple:
-    """``(full, half)``: ``stepper`` (a coarser discretization than ``run``'s) on ``run``'s
-    time steps and on steps twice as long; ``(None, None)``, logged, when one stops (a
-    coarser mesh may not resolve the film).
+def replays(stepper, run, dt: float | None = None):
+    """The :class:`~femehl.accuracy.companions.Replayed` of ``stepper`` (a coarser
+    discretization than ``run``'s) on ``run``'s time steps (``full``) and on steps twice as
+    long (``half``); ``stopped`` when one stops (a coarser mesh may not resolve the film).
+    Nothing is logged here (:func:`_report`).
 
     Fixed steps ``dt``: ``dt`` and ``2 dt``.  Otherwise the run's own times ``run.t``
     (adaptive steps) replayed (:class:`femehl.solver.stepping.GivenSteps`), and every other
     one of them (:func:`every_other_step`).
     """
+    from femehl.accuracy.companions import Replayed
     from femehl.solver.loop import run_loop
     from femehl.solver.stepping import GivenSteps
 
@@ -379,24 +381,26 @@ def replays(stepper, run, dt: float | None = None) -> tuple:
         halves = every_other_step(run.t, breakpoints_of(stepper.scene))
         plans = tuple({"steps": GivenSteps(ts, halvings=REPLAY_HALVINGS)} for ts in (run.t[1:], halves))
     try:
-        out = tuple(run_loop(stepper, t_end, store_every=0, **plan) for plan in plans)
+        full, half = (run_loop(stepper, t_end, store_every=0, **plan) for plan in plans)
     except SolverError as exc:
-        _stopped(exc)
-        return None, None
-    _cut(sum(getattr(plan.get("steps"), "cut", 0) for plan in plans))
-    return out
+        return Replayed(stopped=(type(exc).__name__, str(exc)))
+    cut = sum(getattr(plan.get("steps"), "cut", 0) for plan in plans)
+    return Replayed(full, half, stepper.scheme.order, cut)
 
 
-def _stopped(why) -> None:
-    logger.warning("femehl: no error estimate: the coarser companion run stopped (%s)", why)
-
-
-def _cut(cut: int) -> None:
-    if cut:
+def _report(got, level_c: float) -> None:
+    """Log what the companions (at ``level_c``) could not do: a mesh, a stop, steps cut."""
+    if got.stopped is not None and got.stopped[0] == "MeshError":
+        logger.warning(
+            "femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, got.stopped[1]
+        )
+    elif got.stopped is not None:
+        logger.warning("femehl: no error estimate: the coarser companion run stopped (%s)", got.stopped[1])
+    elif got.cut:
         logger.warning(
             "femehl: the companions cut %d of the run's steps in two (a step failed on their coarser "
             "mesh): their estimate there holds a time error too",
-            cut,
+            got.cut,
         )
 
 
@@ -436,11 +440,11 @@ def companion_run(scene, method, options, run: Result, dt, step_tol) -> tuple:
     if plan is None:
         return None, None, None, None
     coarse_options, ratio = plan
-    stepper = make_stepper(scene, method, **coarse_options)
-    full, half = replays(stepper, run, dt if step_tol is None else None)
-    if full is None:
+    got = replays(make_stepper(scene, method, **coarse_options), run, dt if step_tol is None else None)
+    _report(got, math.nan)
+    if got.stopped is not None:
         return None, None, None, None
-    return full, half, ratio, stepper.scheme.order
+    return got.full, got.half, ratio, got.order
 
 
 def expert_estimate(res: Result, full, half, ratio, order, adaptive: bool):
@@ -568,10 +572,7 @@ def _replay_now(make, run):
         stepper = make()
     except MeshError as exc:  # a mesh this coarse may not be made
         return Replayed(stopped=("MeshError", str(exc)))
-    full, half = replays(stepper, run)  # logs a stop and the steps cut
-    return Replayed(
-        full, half, stepper.scheme.order, stopped=None if full is not None else ("SolverError", "logged")
-    )
+    return replays(stepper, run)
 
 
 def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) -> Estimate | None:
@@ -582,26 +583,20 @@ def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) ->
     ``run`` has ``t``, the :data:`QUANTITIES` and ``info``."""
     t0 = time.perf_counter()
     level_c = COMPANION_RATIO * level
-    got = None if beside is None else beside.results()
+    # a companion does less work than the run: one still busy long after it has hung
+    got = None if beside is None else beside.results(wait=max(60.0, run.info.get("wall", 0.0)))
     if got is not None and got.stopped is None:
         got.full.scene = got.half.scene = scene
-        if _replayed_on(run, got):
-            _cut(got.cut)
-        else:
+        if not _replayed_on(run, got):
             logger.info(
                 "femehl: the companions beside the run missed some of its steps: they replay after it"
             )
             got = None
-    elif got is not None and got.stopped[0] != "MeshError":
-        _stopped(got.stopped[1])
     if got is None:
         got = _replay_now(_companion_maker(scene, method, ladder, t_end, level_c, options), run)
     run.info["estimate_wall"] = time.perf_counter() - t0
+    _report(got, level_c)
     if got.stopped is not None:
-        if got.stopped[0] == "MeshError":
-            logger.warning(
-                "femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, got.stopped[1]
-            )
         return None
     full, half = got.full, got.half
     est = one_run_estimate(run, full, half, COMPANION_RATIO, got.order, (level, level_c))

@@ -10,14 +10,18 @@ linear solver's tolerance.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import multiprocessing
 import os
+import pickle
+import select
 import signal
 import struct
 import sys
 import threading
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -46,7 +50,7 @@ def concurrent() -> bool:
         raise SceneError(f"{ENV}={raw!r}: give 'auto' (the default: beside the run) or 'serial'.")
     if raw == "serial" or not sys.platform.startswith("linux"):
         return False
-    if "fork" not in multiprocessing.get_all_start_methods():
+    if not hasattr(os, "fork"):
         return False
     if multiprocessing.current_process().daemon or threading.current_thread() is not threading.main_thread():
         return False
@@ -106,11 +110,15 @@ class _Times:
             self.buffer += chunk
         (t,) = _RECORD.unpack_from(self.buffer)
         self.buffer = self.buffer[_RECORD.size :]
-        return None if t == _END and self._end() else t
+        if t == _END:
+            self.finished = True
+            return None
+        return t
 
-    def _end(self) -> bool:
-        self.finished = True
-        return True
+    def drain(self) -> None:
+        """Read on to the end marker (or a closed pipe), the times left unused."""
+        while self._read() is not None:
+            pass
 
     def __iter__(self):
         t0 = self._read()  # the run's start
@@ -128,34 +136,38 @@ class _Times:
                 i = 0
 
 
-def _child(make, t_end, breaks, halvings, every_other, fd, conn):
-    """A companion: build its stepper (``make()``), replay the times from ``fd`` (a failed
-    step cut in two up to ``halvings`` times), send ``(outcome, ...)`` on ``conn``; silent
-    when the run was abandoned."""
+def _child(make, t_end, breaks, halvings, every_other, fd, out):
+    """A companion (a forked process that ends here): build its stepper (``make()``),
+    replay the times from ``fd`` (a failed step cut in two up to ``halvings`` times), write
+    ``(outcome, ...)`` pickled to ``out``; nothing when the run was abandoned."""
     from femehl.solver.loop import run_loop
     from femehl.solver.threads import limited
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C stops the run, which ends its companions
-    for w in _OPEN:
-        os.close(w)
     times = _Times(fd, t_end, breaks, every_other)
     try:
-        with limited():
-            stepper = make()
-            steps = _Streamed(iter(times), halvings=halvings)
-            res = run_loop(stepper, t_end, store_every=0, steps=steps)
-        if times.finished:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C stops the run, which ends its companions
+        for w in _OPEN:
+            os.close(w)
+        try:
+            with limited():
+                stepper = make()
+                steps = _Streamed(iter(times), halvings=halvings)
+                res = run_loop(stepper, t_end, store_every=0, steps=steps)
             res.scene = res.disc = None  # the parent has both; a user's shape may not pickle
-            conn.send(("replayed", res, steps.cut, stepper.scheme.order))
-    except (SolverError, MeshError) as exc:
-        for _ in times:  # drain: the outcome is sent once the run has ended
-            pass
+            outcome = ("replayed", res, steps.cut, stepper.scheme.order)
+        except (SolverError, MeshError) as exc:
+            times.drain()  # the outcome is sent once the run has ended
+            outcome = ("stopped", type(exc).__name__, str(exc))
         if times.finished:
-            conn.send(("stopped", type(exc).__name__, str(exc)))
+            data = pickle.dumps(outcome)
+            while data:
+                data = data[os.write(out, data) :]
     except BaseException as exc:  # anything else: the parent replays after the run instead
-        conn.send(("failed", f"{type(exc).__name__}: {exc}"))
+        with contextlib.suppress(BaseException):
+            times.drain()  # the run writes on to its end; the outcome is read then
+            os.write(out, pickle.dumps(("failed", f"{type(exc).__name__}: {exc}")))
     finally:
-        conn.close()
+        os._exit(0)  # a fork: nothing of the parent's exit (atexit, finalizers, streams) runs
 
 
 class Companions:
@@ -170,24 +182,24 @@ class Companions:
     """
 
     def __init__(self, make, t_end: float, breaks=(), halvings: int = 0):
-        ctx = multiprocessing.get_context("fork")
         self._procs = []
+        for stream in (sys.stdout, sys.stderr):  # what the parent has buffered is written once
+            with contextlib.suppress(Exception):
+                stream.flush()
         with warnings.catch_warnings():  # Python >= 3.12 warns of fork beside BLAS's idle threads
             warnings.simplefilter("ignore", DeprecationWarning)
             for every_other in (False, True):
-                r, w = os.pipe()
-                recv, send = ctx.Pipe(duplex=False)
+                r, w = os.pipe()  # the run's times, to the companion
+                back, out = os.pipe()  # its outcome, to the run
                 _OPEN.add(w)
-                proc = ctx.Process(
-                    target=_child,
-                    args=(make, float(t_end), tuple(breaks), halvings, every_other, r, send),
-                    daemon=True,
-                )
-                proc.start()
+                pid = os.fork()
+                if pid == 0:
+                    os.close(back)
+                    _child(make, float(t_end), tuple(breaks), halvings, every_other, r, out)
                 os.close(r)
-                send.close()
+                os.close(out)
                 os.set_blocking(w, False)
-                self._procs.append({"proc": proc, "w": w, "recv": recv, "pending": b""})
+                self._procs.append({"pid": pid, "w": w, "back": back, "pending": b""})
 
     def __enter__(self):
         return self
@@ -216,21 +228,43 @@ class Companions:
         except BrokenPipeError:  # the companion has ended (it failed): results() says so
             p["pending"] = b""
 
-    def results(self) -> Replayed | None:
+    @staticmethod
+    def _read_back(p, deadline: float) -> bytes | None:
+        """A companion's whole outcome (to the end of its pipe), None if not by ``deadline``."""
+        chunks = []
+        while (left := deadline - time.monotonic()) > 0.0:
+            if not select.select([p["back"]], [], [], left)[0]:
+                break
+            chunk = os.read(p["back"], 1 << 20)
+            if not chunk:
+                os.close(p["back"])
+                p["back"] = None
+                return b"".join(chunks)
+            chunks.append(chunk)
+        return None
+
+    def results(self, wait: float = 600.0) -> Replayed | None:
         """The :class:`Replayed` of the run that has just ended (the same as
         :func:`femehl.accuracy.auto.replays` would give); None (logged) when a companion
-        failed otherwise than by stopping: replay after the run instead."""
+        failed otherwise than by stopping, or gave no answer within ``wait`` seconds:
+        replay after the run instead."""
         outcomes = []
         for p in self._procs:
             p["pending"] += _RECORD.pack(_END)
             self._send(p, block=True)
             self._close_pipe(p)
+        deadline = time.monotonic() + wait
         for p in self._procs:
+            data = self._read_back(p, deadline)
+            if data is None:  # no answer in time: a companion hung (a lock held across the fork)
+                outcomes.append(("failed", f"no answer within {wait:.0f} s of the run's end"))
+                continue
+            _, status = os.waitpid(p["pid"], 0)
+            p["pid"] = None
             try:
-                outcomes.append(p["recv"].recv())
-            except (EOFError, OSError):
-                p["proc"].join()
-                outcomes.append(("failed", f"the process ended with code {p['proc'].exitcode}"))
+                outcomes.append(pickle.loads(data))
+            except Exception:  # nothing, or cut short: it died (killed, out of memory)
+                outcomes.append(("failed", f"the process ended with status {status}"))
         self.close()
         failed = [o[1] for o in outcomes if o[0] == "failed"]
         if failed:
@@ -252,9 +286,10 @@ class Companions:
         """End the companions (a run that stopped or was abandoned) and free their pipes."""
         for p in self._procs:
             self._close_pipe(p)
-            p["recv"].close()
-            if p["proc"].is_alive():
-                p["proc"].terminate()
-            p["proc"].join()
-            p["proc"].close()
+            if p["back"] is not None:
+                os.close(p["back"])
+            if p["pid"] is not None:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(p["pid"], signal.SIGTERM)
+                os.waitpid(p["pid"], 0)
         self._procs = []

@@ -71,6 +71,11 @@ class SingleCompliance:
     def __getitem__(self, key):
         return np.asarray(self.a[key], dtype=np.float64)
 
+    def add_product(self, w, out) -> None:
+        """``out += W C`` in place for a sparse ``W`` (``out`` dense, float32 or float64)."""
+        w = sp.csr_matrix(w, dtype=np.float64)
+        _csr_rmatmul(w.indptr, w.indices, w.data, self.a, out)
+
 
 @numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)
 def _matvec(A, x, y):  # pragma: no cover - compiled

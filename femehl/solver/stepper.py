@@ -29,7 +29,7 @@ import scipy.sparse as sp
 
 from femehl.elastic.dense import SingleCompliance, is_dense, stored
 from femehl.errors import SceneError, SingularSystemError
-from femehl.solver.linsolve import LazyProduct, StepOperator, film_rtol_scale, make_linear_solver
+from femehl.solver.linsolve import StepOperator, StepProduct, film_rtol_scale, make_linear_solver
 from femehl.solver.parts import Solved, gap_control
 from femehl.solver.stepping import State, get_scheme
 from femehl.solver.terms import StepContext, terms_for
@@ -221,8 +221,8 @@ class LaggedStepper:
         Fc = F[:, cols]
         if self.fast:
             return sp.csr_matrix(Fc @ sp.csr_matrix(self.C.preconditioner)[cols])
-        if self.dense:  # formed only if the solver reads it (a refactorization)
-            return LazyProduct(lambda: np.asarray(Fc @ self.C[cols]), (F.shape[0], self.C.shape[1]))
+        if self.dense:  # read only when the solver refreshes its preconditioner
+            return StepProduct(F, self.C)
         return sp.csr_matrix(Fc @ sp.csr_matrix(self.C)[cols])
 
     # ---- states -------------------------------------------------------------------------

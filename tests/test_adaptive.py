@@ -9,8 +9,10 @@ a scene whose film closes.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -19,6 +21,7 @@ import pytest
 import femehl
 from femehl.api import make_stepper, run_loop, solve
 from femehl.errors import FilmRuptureError, SceneError, SingularSystemError, SolverError
+from femehl.problem.cavitation import ReynoldsCavitation
 from femehl.problem.line import LineScene
 from femehl.solver.adaptive import AdaptiveSteps, StepController
 from femehl.solver.stepping import SCHEMES, FixedSteps, GivenSteps, State, film_positive, march
@@ -130,6 +133,23 @@ class LaggedCubic(ScalarODE):
         hist = state.d[0] if omega is None else a1 * state.d[0] - a2 * state.d_prev[0]
         y = (hist + dt * self.fc) / (a0 + dt * state.d[0] ** 2)
         return self._state(state.step + 1, t_new, y, d_prev=state.d, dt_prev=dt)
+
+
+class Flicker(ScalarODE):
+    """``y' = 1 - y``, ``y(0) = 1``, each step off by a relative ``+-eps``, alternating: a
+    period-two pattern whose size does not follow the step (no divergence of a lag).  With
+    ``switching``, a one-node cavitated set (Reynolds) flips with it, as in deep contact."""
+
+    def __init__(self, eps, switching=False, t_on=0.0):
+        super().__init__(y0=1.0, a=0.0, breakpoints=False)
+        self.eps, self.t_on = eps, t_on
+        self.cavitation = ReynoldsCavitation if switching else None
+
+    def step(self, state, t_new, dt):
+        new = super().step(state, t_new, dt)
+        sign = (-1) ** new.step if t_new > self.t_on else 0
+        new = self._state(new.step, t_new, new.d[0] * (1.0 + self.eps * sign), state.d, dt)
+        return replace(new, own={"p_aux": np.array([float(sign)])}) if self.cavitation else new
 
 
 def _run(stepper, t_end, start=None, **kw):
@@ -250,6 +270,40 @@ def test_the_lag_mode_is_caught(caplog):
     assert len(caught) == 1
     assert abs(states[-1].d[0] - 2.0) < 1e-12
     assert max(s.info["dt"] for s in states[-20:]) < 1.0
+
+
+def test_a_flicker_below_the_tolerance_is_not_the_lag_mode(caplog):
+    """A period-two alternation of relative size 1e-6 (a third of ``LAG_FLOOR * tol`` at tol
+    1e-3) costs no accuracy and does not shrink with the step: the run on steps up to 0.1 is
+    not capped for it (before, the check took it for the lag's mode on every step below 1,
+    capped the steps a quarter at a time and stopped at the step floor).  A diverging mode
+    is still caught (:func:`test_the_lag_mode_is_caught`)."""
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        steps = march(Flicker(eps=5e-7), 20.0, AdaptiveSteps(tol=1e-3, dt_max=0.1))
+        states = list(itertools.islice(steps, 1000))  # capped, the old check crawled on at dt_min
+    assert not [r for r in caplog.records if "oscillates from step to step" in r.getMessage()]
+    assert states[-1].t == 20.0
+    assert max(abs(s.d[0] - 1.0) for s in states) < 1e-6
+    assert sum(s.info["dt"] == pytest.approx(0.1) for s in states) > 150
+
+
+@pytest.mark.parametrize("switching", [False, True])
+def test_a_flicker_of_the_cavitated_set_is_not_the_lag_mode(caplog, switching):
+    """From t = 5, on steps near the ceiling of 1, an alternation of relative size 1e-4 at
+    tol 1e-2 (above ``LAG_FLOOR * tol``) is taken for the lag's mode and capped; the same
+    alternation while the cavitated set flips a node is the set's (as on the rough PDMS ball
+    in deep contact at 1.8e-8 m/s, where the set flipped up to hundreds of nodes per step
+    and the check capped the steps ten times in a row, down to the step floor): the run
+    goes on at the ceiling."""
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        steps = march(Flicker(1e-4, switching, t_on=5.0), 20.0, AdaptiveSteps(tol=1e-2, dt_max=1.0))
+        states = list(itertools.islice(steps, 1000))
+    caught = [r for r in caplog.records if "oscillates from step to step" in r.getMessage()]
+    if switching:
+        assert not caught and states[-1].t == 20.0
+        assert sum(s.info["dt"] == pytest.approx(1.0) for s in states if s.t > 5.0) >= 12
+    else:
+        assert caught and "at t = 8" in caught[0].getMessage()
 
 
 def test_info_fields():

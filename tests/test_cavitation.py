@@ -12,17 +12,21 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
 import femehl
 from femehl.errors import SceneError
+from femehl.problem.cavitation import SET_BAND, ReynoldsCavitation
 from femehl.problem.line import LineScene
 from femehl.problem.scene import Constant, Fluid, Motion
 from femehl.solver.energetics import FRICTION_COLUMNS
+from femehl.solver.stepping import State
 
 HC, BETA, L, V = 0.2, 10.0, 2.0, 1.0
 
@@ -372,3 +376,41 @@ def test_impulsive_start_with_a_lagged_set_in_the_automatic_mode():
     r = femehl.solve(sc, t_end=4.0)
     assert r.load[-1] == pytest.approx(ref.load, rel=1e-3)
     assert r.film_min[-1] == pytest.approx(ref.film_min, rel=1e-3)
+
+
+def test_a_node_within_round_off_of_zero_keeps_its_side_of_the_set():
+    """Reynolds: the next set is ``{y < 0}`` but a node whose ``y`` is within ``SET_BAND`` of
+    the largest ``|y|`` (1e-6 of it: the solve's round-off, as where asperities carry the
+    load and the film's pressure is noise) keeps its side: a free node at -3e-7 stays free,
+    a held node whose multiplier is 3e-7 stays held; outside the band the sign decides."""
+    free_p = np.array([1.0, 0.5, 3e-7, -3e-7, -0.2])  # free nodes 0-4: p
+    held_rhs = np.array([3e-7, 0.1])  # held nodes 5, 6: y = -(D p - rhs) = rhs (p = 0 there)
+    n = free_p.size + held_rhs.size
+    p = np.concatenate([free_p, np.zeros(2)])
+    fixed = np.array([5, 6])
+    op = SimpleNamespace(D=sp.identity(n, format="csr"), G=sp.csr_matrix((n, 1)))
+    rhs = np.concatenate([np.zeros(free_p.size), held_rhs])
+    state = SimpleNamespace(own={"p_aux": np.zeros(n)})
+    solved = SimpleNamespace(op=op, rhs=rhs, p=p, aux=fixed, scale=1.0, state=state)
+    stepper = SimpleNamespace(film_pressure=lambda new, p: p, g=np.ones(n), disc=None)
+    new = State(
+        step=1,
+        t=0.1,
+        hc=0.0,
+        V=0.0,
+        p=p,
+        w=p,
+        d=np.ones(1),
+        load=0.0,
+        film_center=1.0,
+        film_min=1.0,
+        film_min_at=(0.0, 0.0),
+        p_max=1.0,
+        p_max_at=(0.0, 0.0),
+    )
+    out = ReynoldsCavitation().finish(stepper, solved, new)
+    y = out.own["p_aux"]
+    assert list(np.flatnonzero(y < 0.0)) == [4, 5]  # 3 stays free, 5 stays held, 6 is released
+    assert y[[0, 1, 4, 6]] == pytest.approx([1.0, 0.5, -0.2, 0.1], rel=1e-15)
+    assert np.all(np.abs(y[[2, 3, 5]]) == SET_BAND)
+    assert list(ReynoldsCavitation.fixed(out)) == [4, 5]

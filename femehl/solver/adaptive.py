@@ -40,12 +40,13 @@ LOAD_FLOOR = 0.1
 UNIT_STEP = 0.01
 #: the lag's period-two mode (:func:`_lag_mode`): three film increments in a row, each with a
 #: cosine below -LAG_COSINE to the one before, the last at least LAG_RATIO of the one before
-#: and above LAG_FLOOR of the step's tolerance; the step is then retried, and every later one
-#: kept, below LAG_SHARE of it (a quarter: the time companion's steps, twice the run's, stay
-#: below half of it)
+#: and its largest relative change above LAG_FLOOR times tol (an oscillation that small is
+#: harmless; a diverging one crosses it within steps); the step is then retried, and every
+#: later one kept, below LAG_SHARE of it (a quarter: the time companion's steps, twice the
+#: run's, stay below half of it)
 LAG_COSINE = 0.5
 LAG_RATIO = 0.9
-LAG_FLOOR = 1e-3
+LAG_FLOOR = 3e-3
 LAG_SHARE = 0.25
 #: keyword arguments of :class:`AdaptiveSteps` that tune the controller
 CONTROLS = ("dt0", "dt_min", "dt_max", "safety")
@@ -114,6 +115,8 @@ class _Run:
     #: ``settled(states)``: the film points the estimate reads (None: all), from the fluid's
     #: cavitation model (JFO: not the cells whose nodes switched set)
     settled: object = None
+    #: ``switched(states)``: whether the cavitated set switched a node over them (None: no set)
+    switched: object = None
 
 
 @dataclass(frozen=True)
@@ -406,10 +409,12 @@ class AdaptiveSteps:
         self._stepper, self._order = stepper, _order(stepper)
         self._ctl = StepController(self.tol, self.safety)
         self._dt0, self._dt_min, self._dt_max, self._eps, self._t_end = dt0, dt_min, dt_max, eps, t_end
-        cells = getattr(getattr(stepper, "cavitation", None), "settled_cells", None)
+        cavitation = getattr(stepper, "cavitation", None)
+        cells = getattr(cavitation, "settled_cells", None)
         disc = getattr(stepper, "disc", None)
         self._run = _Run(
             settled=None if cells is None else (lambda states: cells(disc, states)),
+            switched=getattr(cavitation, "set_switched", None),
             dt=dt0,
             levels=[without_history(state)],
             load_scale=abs(_load(state)),
@@ -481,7 +486,7 @@ class AdaptiveSteps:
         if not ctl.accepts(err):
             self._refuse(err, p, t_new, h)
             return
-        if run.pending is None and h > dt_min * (1.0 + 1e-9) and _lag_mode(run, trial, h, ctl.tol):
+        if run.pending is None and h > dt_min * (1.0 + 1e-9) and _lag_mode(run, trial, ctl.tol):
             self._dt_max = max(dt_min, LAG_SHARE * h)
             logger.info(
                 "femehl: at t = %.4g the film oscillates from step to step at steps of %.3g (the "
@@ -543,29 +548,33 @@ class AdaptiveSteps:
             logger.debug("adaptive: breakpoint t = %.6g, restart with dt = %.3g", stop, run.dt)
 
 
-def _lag_mode(run: _Run, trial: State, h: float, tol: float) -> bool:
+def _lag_mode(run: _Run, trial: State, tol: float) -> bool:
     """True when the film's last three increments (two levels and the trial) are the lag's
     period-two mode: each opposite to the one before (cosines below ``-LAG_COSINE``), the
-    last at least ``LAG_RATIO`` of the one before, and not round-off (its largest relative
-    change above ``LAG_FLOOR`` of what the tolerance allows a step).  With its coefficients
-    lagged a step is one iteration of the steady problem's fixed point, which diverges in
-    sign-alternating increments on steps too long for the time derivative to damp it;
-    Milne's estimate, per unit time, passes those steps.  A physical turning point reverses
-    the increments once; a pattern that reverses every step is no evolution the steps
-    resolve, whatever made it."""
+    last at least ``LAG_RATIO`` of the one before and large enough to matter (its largest
+    relative change above ``LAG_FLOOR * tol``: a diverging mode crosses it within a few
+    steps), on steps over which the cavitated set held still.
+
+    With its coefficients lagged a step is one iteration of the steady problem's fixed
+    point, which diverges in sign-alternating increments on steps too long for the time
+    derivative to damp it; Milne's estimate, per unit time, passes those steps.  A physical
+    turning point reverses the increments once; a pattern that reverses every step is no
+    evolution the steps resolve.  Where the lagged set switches, it flips nodes back and
+    forth on steps of any length (in deep contact, where the film's pressure is round-off),
+    and through the elasticity the whole film follows: that is no divergence of the fixed
+    point, and shorter steps do not end it."""
     if len(run.levels) < 3:
+        return False
+    if run.switched is not None and run.switched([*run.levels, trial]):
         return False
     d = np.asarray(trial.d, dtype=float)
     scale = np.maximum(d, (trial.info or {}).get("film_error_floor", 0.0))
     films = [np.asarray(s.d, dtype=float) for s in run.levels[-3:]] + [d]
     steps = [(b - a) / scale for a, b in itertools.pairwise(films)]
-    keep = None if run.settled is None else run.settled([*run.levels, trial])
-    if keep is not None and keep.any():
-        steps = [x[keep] for x in steps]
     norms = [float(np.linalg.norm(x)) for x in steps]
     if not min(norms) > 0.0 or norms[2] < LAG_RATIO * norms[1]:
         return False
-    if np.max(np.abs(steps[2])) <= LAG_FLOOR * tol * max(h, UNIT_STEP):
+    if np.max(np.abs(steps[2])) <= LAG_FLOOR * tol:
         return False
     return all(
         float(a @ b) < -LAG_COSINE * na * nb

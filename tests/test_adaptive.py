@@ -272,6 +272,20 @@ def test_the_lag_mode_is_caught(caplog):
     assert max(s.info["dt"] for s in states[-20:]) < 1.0
 
 
+def test_the_steps_after_a_catch_are_not_judged_on_the_ones_before(caplog):
+    """The lagged cubic with f = 64 diverges faster: the first steps after the catch, a
+    quarter as long, still undo the oscillation that the longer ones left, and read with
+    those they looked like the mode again (measured before: caught at 0.834 and at once at
+    0.208, 2,025 steps to t = 100); the check now reads only steps after the catch: one
+    catch, 601 steps, y* = 4 to 1e-12."""
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        states = _run(LaggedCubic(f=64.0), 100.0, tol=1e-3, dt_max=10.0)
+    caught = [r.getMessage() for r in caplog.records if "oscillates from step to step" in r.getMessage()]
+    assert len(caught) == 1 and "steps of 0.834" in caught[0]
+    assert abs(states[-1].d[0] - 4.0) < 1e-12
+    assert len(states) < 700
+
+
 def test_a_flicker_below_the_tolerance_is_not_the_lag_mode(caplog):
     """A period-two alternation of relative size 1e-6 (a third of ``LAG_FLOOR * tol`` at tol
     1e-3) costs no accuracy and does not shrink with the step: the run on steps up to 0.1 is

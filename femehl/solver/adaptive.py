@@ -117,6 +117,8 @@ class _Run:
     settled: object = None
     #: ``switched(states)``: whether the cavitated set switched a node over them (None: no set)
     switched: object = None
+    #: where the last catch of the lag's mode retried its step: the check reads the steps after it
+    lag_from: float = -math.inf
 
 
 @dataclass(frozen=True)
@@ -488,6 +490,7 @@ class AdaptiveSteps:
             return
         if run.pending is None and h > dt_min * (1.0 + 1e-9) and _lag_mode(run, trial, ctl.tol):
             self._dt_max = max(dt_min, LAG_SHARE * h)
+            run.lag_from = run.levels[-1].t
             logger.info(
                 "femehl: at t = %.4g the film oscillates from step to step at steps of %.3g (the "
                 "lagged coefficients' fixed point diverges): steps are kept below %.3g from here on",
@@ -553,7 +556,8 @@ def _lag_mode(run: _Run, trial: State, tol: float) -> bool:
     period-two mode: each opposite to the one before (cosines below ``-LAG_COSINE``), the
     last at least ``LAG_RATIO`` of the one before and large enough to matter (its largest
     relative change above ``LAG_FLOOR * tol``: a diverging mode crosses it within a few
-    steps), on steps over which the cavitated set held still.
+    steps), on steps over which the cavitated set held still, all after the last catch
+    (the first steps after it, shorter, still undo the oscillation the longer ones left).
 
     With its coefficients lagged a step is one iteration of the steady problem's fixed
     point, which diverges in sign-alternating increments on steps too long for the time
@@ -563,7 +567,7 @@ def _lag_mode(run: _Run, trial: State, tol: float) -> bool:
     forth on steps of any length (in deep contact, where the film's pressure is round-off),
     and through the elasticity the whole film follows: that is no divergence of the fixed
     point, and shorter steps do not end it."""
-    if len(run.levels) < 3:
+    if len(run.levels) < 3 or run.levels[-3].t < run.lag_from:
         return False
     if run.switched is not None and run.switched([*run.levels, trial]):
         return False

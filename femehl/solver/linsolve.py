@@ -136,10 +136,9 @@ class StepOperator:
                         if k == 0:
                             a[:] = 0.0
                         FC.add_into(a, c, s)
-                    elif k == 0:
-                        np.multiply(FC[s : s + blk], c, out=a)
-                    else:
-                        np.multiply(FC[s : s + blk], c, out=b)
+                        continue
+                    np.multiply(FC[s : s + blk], c, out=b if k else a)
+                    if k:
                         a += b
                 A[s : s + blk] = a
         Dc = self.D.tocoo()

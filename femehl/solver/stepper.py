@@ -217,13 +217,11 @@ class LaggedStepper:
     def _step_product(self, F):
         """``F C`` of a film operator of one step: only the columns F uses are touched."""
         F = sp.csr_matrix(F)
-        cols = np.unique(F.indices)
-        Fc = F[:, cols]
-        if self.fast:
-            return sp.csr_matrix(Fc @ sp.csr_matrix(self.C.preconditioner)[cols])
-        if self.dense:  # read only when the solver refreshes its preconditioner
+        if self.dense and not self.fast:  # read only when the solver refreshes its preconditioner
             return StepProduct(F, self.C)
-        return sp.csr_matrix(Fc @ sp.csr_matrix(self.C)[cols])
+        cols = np.unique(F.indices)
+        C = self.C.preconditioner if self.fast else self.C
+        return sp.csr_matrix(F[:, cols] @ sp.csr_matrix(C)[cols])
 
     # ---- states -------------------------------------------------------------------------
     def _state(self, step, t, hc, V, p, Cp=None, d_prev=None, dt_prev=None, info=None, mem=None) -> State:

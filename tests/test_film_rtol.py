@@ -15,7 +15,7 @@ import pytest
 
 import femehl
 import femehl.solver.stepper as stepper_module
-from femehl import Domain, Fluid, HalfSpace, Motion, RampHold, Scene, Sphere, TanhStart
+from femehl import Domain, Fluid, HalfSpace, Motion, RampHold, Roughness, Scene, Sphere, TanhStart
 from femehl.solver import linsolve
 from femehl.solver.linsolve import FILM_RTOL_FLOOR, FILM_RTOL_REF, film_rtol_scale
 
@@ -71,6 +71,55 @@ def test_residual_follows_the_film(monkeypatch, direct):
 def test_unscaled_residual_leaves_a_larger_film_error(monkeypatch, direct):
     """The same run with the scaling switched off: the film error the test above bounds is
     then 30 times larger (so the bound above tests the scaling, not the solver)."""
-    monkeypatch.setattr(stepper_module, "film_rtol_scale", lambda d, w: 1.0)
+    monkeypatch.setattr(stepper_module, "film_tolerances", lambda d, w, floor, scale: (1.0, None))
     res = femehl.solve(_scene(), **KW)
     assert np.abs(res.film_min / direct.film_min - 1.0).max() > 2e-5
+
+
+def _rough_scene():
+    """The PDMS ball of examples/pdms_ball.toml at 1e-7 m/s (its beta and roughness), pressed
+    by a gap into deep contact: the asperities carry > 99 % of the load, the film is -1.6 sigma."""
+    rough = Roughness(0.0027777777777777775, 0.012252487779635756, friction=0.3, aspect=0.13764944032233706)
+    motion = Motion(gap=RampHold(0.0, -0.1, 0.5), velocity=1.0)
+    return Scene(fluid=Fluid(3e8, cavitation="reynolds"), motion=motion, roughness=rough)
+
+
+def _film_errors(monkeypatch):
+    """Each Krylov solve's film error ``max |C (x - x_lu)|``, against the direct solve of the
+    same system, over an adaptive run into deep contact; in units of sigma."""
+    errors = []
+    solve_one = linsolve.RecycledGCR._solve_one
+
+    def compared(self, op, G, b, t):
+        x, Cx = solve_one(self, op, G, b, t)
+        exact = self.direct.solve(op, [b], t)[0][0]
+        errors.append(float(np.max(np.abs(op.C @ (x - exact)))))
+        return x, Cx
+
+    monkeypatch.setattr(linsolve.RecycledGCR, "_solve_one", compared)
+    scene = _rough_scene()
+    res = femehl.solve(scene, t_end=1.0, mesh="coarse", scheme="bdf2", step_tol=1e-2, estimate=False)
+    assert res.states[-1].info["asperity_share"] > 0.99 and res.film_min.min() < -scene.roughness.sigma
+    return np.array(errors) / scene.roughness.sigma, res
+
+
+def test_rough_contact_solve_error_is_checked_on_the_film(monkeypatch):
+    """Asperities in deep contact make the system ill-conditioned: a relative residual of
+    1e-8 leaves films wrong by up to 3.6e-3 sigma, which in the step error's scale (sigma per
+    UNIT_STEP) is 0.1 -- ten times the step tolerance, so the steps shrank to chase it (the
+    Stribeck curve's slowest speeds: 32,825 steps instead of 1,256).  The film check
+    (``film_tolerances``, FILM_SOLVE_REL = 1e-6 sigma) keeps every solve within 1e-4 sigma
+    of the direct solve (measured 4.5e-5; the check is an estimate through the single-precision
+    LU), where the solve noise is 3e-3 of the step tolerance."""
+    errors, res = _film_errors(monkeypatch)
+    assert res.info["film_checks"] > 0
+    assert errors.max() < 1e-4
+
+
+def test_rough_contact_solve_error_without_the_check(monkeypatch):
+    """The control: the same run with the check off leaves film errors above 1e-3 sigma."""
+    monkeypatch.setattr(
+        stepper_module, "film_tolerances", lambda d, w, floor, scale: (film_rtol_scale(d, w), None)
+    )
+    errors, _ = _film_errors(monkeypatch)
+    assert errors.max() > 1e-3

@@ -248,9 +248,6 @@ class AsperityContact(StepPart):
             history = ctx.a1 * hT - ctx.a2 * rough.mean_gap(state.d_prev)[0]
         else:
             history = hT
-        from femehl.solver.linsolve import film_rtol_scale
-
-        stepper.solver.rtol_scale = film_rtol_scale(hT, state.w)  # the film the solve must resolve
         return dataclasses.replace(ctx, d=hT, d_lag=hT_star, history=history)
 
     def _linearize(self, d_star):

@@ -29,7 +29,7 @@ import scipy.sparse as sp
 
 from femehl.elastic.dense import SingleCompliance, is_dense, stored
 from femehl.errors import SceneError, SingularSystemError
-from femehl.solver.linsolve import StepOperator, StepProduct, film_rtol_scale, make_linear_solver
+from femehl.solver.linsolve import StepOperator, StepProduct, film_tolerances, make_linear_solver
 from femehl.solver.parts import Solved, gap_control
 from femehl.solver.stepping import State, get_scheme
 from femehl.solver.terms import StepContext, terms_for
@@ -367,6 +367,8 @@ class LaggedStepper:
         ctx = self._context(state, t_new, dt)
         film = self._film(state, t_new, dt)
         scale = 1.0 if film is None else film.scale
+        floor = (state.info or {}).get("film_error_floor", 0.0)  # the film the solve must resolve
+        self.solver.rtol_scale, self.solver.film_atol = film_tolerances(ctx.d, state.w, floor, scale)
         op, rhs = self.operator(ctx, scale)
         G = op.G if film is None else op.G / scale  # the terms' G (op.G carries the film's scale)
         shape = self.shape if film is None else self.shape + film.offset
@@ -437,7 +439,6 @@ class LaggedStepper:
         for part in self.parts:
             lagged = part.lagged(state, free_index)
             p_old = p_old if lagged is None else lagged
-        self.solver.rtol_scale = film_rtol_scale(state.d, state.w)  # the residual follows the film
         ctx = StepContext(
             t_new=t_new,
             dt=dt,

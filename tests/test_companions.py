@@ -135,3 +135,20 @@ def test_the_switch_is_checked(monkeypatch):
     monkeypatch.setenv(comp.ENV, "threads")
     with pytest.raises(SceneError, match="'auto'"):
         comp.concurrent()
+
+
+def test_expert_adaptive_run_whose_companion_stops_keeps_the_controller_estimate(monkeypatch, caplog):
+    """A companion that stops (the rough PDMS ball at 1e-3 m/s on the medium mesh: its coarser
+    replay on steps twice as long overshot the rough limit at t = 5.78) leaves an adaptive
+    expert run the step controller's time error, and the log says so (it said "no error
+    estimate" while one was given)."""
+    import femehl.accuracy.auto as auto
+
+    monkeypatch.setattr(auto, "replays", lambda *a, **k: comp.Replayed(stopped=("FilmRuptureError", "test")))
+    with caplog.at_level(logging.WARNING, logger="femehl"):
+        res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.2, mesh="medium", step_tol=1e-2)
+    assert res.estimate is not None and res.estimate.how == "controller"
+    assert res.estimate.worst("time") > 0.0
+    msg = " ".join(r.getMessage() for r in caplog.records)
+    assert "no space error estimate (the estimate is the step controller's time error alone)" in msg
+    assert "coarser companion run stopped (test)" in msg

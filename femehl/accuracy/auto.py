@@ -388,14 +388,14 @@ def replays(stepper, run, dt: float | None = None):
     return Replayed(full, half, stepper.scheme.order, cut)
 
 
-def _report(got, level_c: float) -> None:
-    """Log what the companions (at ``level_c``) could not do: a mesh, a stop, steps cut."""
+def _report(got, level_c: float, left: str = "") -> None:
+    """Log what the companions (at ``level_c``) could not do: a mesh, a stop, steps cut;
+    ``left``: what estimate is left without them (none by default)."""
+    lost = "no error estimate" if not left else f"no space error estimate ({left})"
     if got.stopped is not None and got.stopped[0] == "MeshError":
-        logger.warning(
-            "femehl: no error estimate: the companions' mesh (level %.3g): %s", level_c, got.stopped[1]
-        )
+        logger.warning("femehl: %s: the companions' mesh (level %.3g): %s", lost, level_c, got.stopped[1])
     elif got.stopped is not None:
-        logger.warning("femehl: no error estimate: the coarser companion run stopped (%s)", got.stopped[1])
+        logger.warning("femehl: %s: the coarser companion run stopped (%s)", lost, got.stopped[1])
     elif got.cut:
         logger.warning(
             "femehl: the companions cut %d of the run's steps in two (a step failed on their coarser "
@@ -441,7 +441,9 @@ def companion_run(scene, method, options, run: Result, dt, step_tol) -> tuple:
         return None, None, None, None
     coarse_options, ratio = plan
     got = replays(make_stepper(scene, method, **coarse_options), run, dt if step_tol is None else None)
-    _report(got, math.nan)
+    _report(
+        got, math.nan, "" if step_tol is None else "the estimate is the step controller's time error alone"
+    )
     if got.stopped is not None:
         return None, None, None, None
     return got.full, got.half, ratio, got.order

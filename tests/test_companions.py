@@ -152,3 +152,41 @@ def test_expert_adaptive_run_whose_companion_stops_keeps_the_controller_estimate
     msg = " ".join(r.getMessage() for r in caplog.records)
     assert "no space error estimate (the estimate is the step controller's time error alone)" in msg
     assert "coarser companion run stopped (test)" in msg
+
+
+def _half_replay_stops(monkeypatch):
+    """The companion's replay on every other step raises, as the rough PDMS ball's did."""
+    import femehl.solver.loop as loop
+    from femehl.errors import SolverError
+    from femehl.solver.stepping import GivenSteps
+
+    real, replays = loop.run_loop, []
+
+    def run_loop(stepper, t_end, *args, **kw):
+        if isinstance(kw.get("steps"), GivenSteps) and kw.get("store_every") == 0:
+            replays.append(kw["steps"])
+            if len(replays) == 2:
+                raise SolverError("the step overshot (test)", t=0.1)
+        return real(stepper, t_end, *args, **kw)
+
+    monkeypatch.setattr(loop, "run_loop", run_loop)
+    return replays
+
+
+def test_expert_run_whose_doubled_step_companion_stops_keeps_its_space_estimate(monkeypatch, caplog):
+    """Only the companion on steps twice as long stops (the rough PDMS ball at 1e-3 m/s on
+    the medium mesh: its doubled steps, 1.4 time units after the run's 0.8 was cut, overshot
+    the rough limit at t = 5.78): the estimate keeps the companion's space part, exactly
+    the one of the whole companion pair, and takes the step controller's time part."""
+    scene, kw = femehl.presets.paper_sphere(), dict(t_end=0.2, mesh="medium", step_tol=1e-2)
+    both = femehl.solve(scene, **kw)
+    replays = _half_replay_stops(monkeypatch)
+    with caplog.at_level(logging.WARNING, logger="femehl"):
+        res = femehl.solve(scene, **kw)
+    assert len(replays) == 2 and res.estimate.how == "companion+controller"
+    assert "the coarser companion on steps twice as long stopped (the step overshot (test))" in caplog.text
+    for name in ("load", "film_center", "film_min"):
+        np.testing.assert_array_equal(res.estimate[name]["space"], both.estimate[name]["space"])
+    controller = femehl.accuracy.auto.time_error(res)
+    np.testing.assert_array_equal(res.estimate["load"]["time"], controller)
+    assert controller[-1] > 0.0

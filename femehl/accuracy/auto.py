@@ -363,8 +363,11 @@ def every_other_step(times, breaks=()) -> list[float]:
 def replays(stepper, run, dt: float | None = None):
     """The :class:`~femehl.accuracy.companions.Replayed` of ``stepper`` (a coarser
     discretization than ``run``'s) on ``run``'s time steps (``full``) and on steps twice as
-    long (``half``); ``stopped`` when one stops (a coarser mesh may not resolve the film).
-    Nothing is logged here (:func:`_report`).
+    long (``half``); ``stopped`` when one stops (a coarser mesh may not resolve the film),
+    ``half_stopped`` when only the one on steps twice as long does on adaptive steps (whose
+    controller has a time error of its own: a rough ball's doubled steps, 1.4 time units
+    after the run's own 0.8 had been cut, overshot the rough limit).  Nothing is logged
+    here (:func:`_report`).
 
     Fixed steps ``dt``: ``dt`` and ``2 dt``.  Otherwise the run's own times ``run.t``
     (adaptive steps) replayed (:class:`femehl.solver.stepping.GivenSteps`), and every other
@@ -381,17 +384,29 @@ def replays(stepper, run, dt: float | None = None):
         halves = every_other_step(run.t, breakpoints_of(stepper.scene))
         plans = tuple({"steps": GivenSteps(ts, halvings=REPLAY_HALVINGS)} for ts in (run.t[1:], halves))
     try:
-        full, half = (run_loop(stepper, t_end, store_every=0, **plan) for plan in plans)
+        full = run_loop(stepper, t_end, store_every=0, **plans[0])
     except SolverError as exc:
         return Replayed(stopped=(type(exc).__name__, str(exc)))
-    cut = sum(getattr(plan.get("steps"), "cut", 0) for plan in plans)
-    return Replayed(full, half, stepper.scheme.order, cut)
+    cut = getattr(plans[0].get("steps"), "cut", 0)
+    try:
+        half = run_loop(stepper, t_end, store_every=0, **plans[1])
+    except SolverError as exc:
+        if dt is not None:
+            return Replayed(stopped=(type(exc).__name__, str(exc)))
+        return Replayed(full, None, stepper.scheme.order, cut, half_stopped=(type(exc).__name__, str(exc)))
+    return Replayed(full, half, stepper.scheme.order, cut + getattr(plans[1].get("steps"), "cut", 0))
 
 
 def _report(got, level_c: float, left: str = "") -> None:
     """Log what the companions (at ``level_c``) could not do: a mesh, a stop, steps cut;
     ``left``: what estimate is left without them (none by default)."""
     lost = "no error estimate" if not left else f"no space error estimate ({left})"
+    if got.half_stopped is not None:
+        logger.warning(
+            "femehl: the time part of the error estimate is the step controller's: the coarser "
+            "companion on steps twice as long stopped (%s)",
+            got.half_stopped[1],
+        )
     if got.stopped is not None and got.stopped[0] == "MeshError":
         logger.warning("femehl: %s: the companions' mesh (level %.3g): %s", lost, level_c, got.stopped[1])
     elif got.stopped is not None:
@@ -413,11 +428,16 @@ def one_run_estimate(run, full: Result, half: Result, ratio: float, order: int =
     space only).  ``time``: BDF2's Richardson estimate ``|q_full - q_half| / 3`` at
     ``half``'s times relative to ``run``'s values (``2**order - 1`` for a scheme of another
     ``order``), the running maximum, the coarser mesh standing for the run's (the same
-    steps).  ``total = space + time``; ``levels``: (run's, companions') when known.
+    steps); with ``half`` None (it stopped) the step controller's accumulated local error
+    (:func:`time_error`).  ``total = space + time``; ``levels``: (run's, companions') when known.
     """
     errors = {}
     for name in QUANTITIES:
         space = np.maximum.accumulate(pair_error(run, full, name, ratio))
+        if half is None:
+            tpart = time_error(run)
+            errors[name] = {"total": space + tpart, "space": space, "time": tpart}
+            continue
         th = np.asarray(half.t, dtype=float)
         qh = getattr(half, name)
         qf = np.array([full.value_at(name, t) for t in th])
@@ -425,7 +445,8 @@ def one_run_estimate(run, full: Result, half: Result, ratio: float, order: int =
         e = np.abs(qf - qh) / (2.0**order - 1.0) / _scale(name, qr, getattr(run, "scene", None))
         tpart = np.maximum.accumulate(np.interp(run.t, th, e))
         errors[name] = {"total": space + tpart, "space": space, "time": tpart}
-    return Estimate(np.asarray(run.t, dtype=float), errors, "companion", ratio, tuple(levels))
+    how = "companion" if half is not None else "companion+controller"
+    return Estimate(np.asarray(run.t, dtype=float), errors, how, ratio, tuple(levels))
 
 
 def companion_run(scene, method, options, run: Result, dt, step_tol) -> tuple:
@@ -597,6 +618,8 @@ def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) ->
     if got is None:
         got = _replay_now(_companion_maker(scene, method, ladder, t_end, level_c, options), run)
     run.info["estimate_wall"] = time.perf_counter() - t0
+    if got.half_stopped is not None:  # the automatic mode's estimate needs both companions
+        got = dataclasses.replace(got, full=None, stopped=got.half_stopped, half_stopped=None)
     _report(got, level_c)
     if got.stopped is not None:
         return None

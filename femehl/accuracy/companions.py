@@ -61,13 +61,15 @@ def concurrent() -> bool:
 class Replayed:
     """What the companions sent back: the replays on every step (``full``) and on every
     other (``half``), the scheme's ``order``, how many steps they ``cut`` in two; or
-    ``stopped``, ``(error class name, message)`` of the one that stopped (the others None)."""
+    ``stopped``, ``(error class name, message)`` of the one that stopped (the others None);
+    or ``half_stopped``, of the replay on every other step alone (``half`` None)."""
 
     full: object = None
     half: object = None
     order: int = 2
     cut: int = 0
     stopped: tuple | None = None
+    half_stopped: tuple | None = None
 
 
 class _Streamed(GivenSteps):

@@ -19,9 +19,10 @@ __all__ = ["Estimate", "PARTS", "HOWS"]
 
 #: the parts of each quantity's estimate
 PARTS = ("total", "space", "time")
-#: how an estimate was made: a run's coarser companions (its space and time parts), or its
-#: step controller only (time)
-HOWS = ("companion", "controller")
+#: how an estimate was made: a run's coarser companions (its space and time parts), its
+#: step controller only (time), or a companion on the run's steps (space) with the step
+#: controller's time part (the companion on steps twice as long stopped)
+HOWS = ("companion", "controller", "companion+controller")
 
 
 @dataclass(frozen=True)

@@ -171,6 +171,11 @@ class RunFolder:
                 f"femehl: error estimate from companion runs {res.estimate.ratio:.3g} times coarser on the "
                 "run's steps (space) and on steps twice as long (time)"
             )
+        elif res.estimate is not None and res.estimate.how == "companion+controller":
+            self.say(
+                f"femehl: error estimate from a companion run {res.estimate.ratio:.3g} times coarser on the "
+                "run's steps (space) and the step controller's local errors (time)"
+            )
         self.say_choice(res.info.get("auto", {}))
         return res
 

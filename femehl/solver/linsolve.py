@@ -726,8 +726,9 @@ def film_rtol_scale(d, w) -> float:
     return float(max(FILM_RTOL_FLOOR, max(dmin, 0.0) / (FILM_RTOL_REF * wmax)))
 
 
-#: where the film is thin (:func:`film_rtol_scale` below 1), the solve's film error is also
-#: checked, at most FILM_SOLVE_REL times the film's scale (``RecycledGCR._film_check``)
+#: where the film is thin (:func:`film_rtol_scale` below 1) or may close (a floor), the
+#: solve's film error is also checked, at most FILM_SOLVE_REL times the film's scale
+#: (:func:`film_tolerances`, ``RecycledGCR._film_check``)
 FILM_SOLVE_REL = 1e-6
 
 

@@ -360,14 +360,14 @@ def every_other_step(times, breaks=()) -> list[float]:
     return [float(t[i]) for i in keep]
 
 
-def replays(stepper, run, dt: float | None = None):
+def replays(stepper, run, dt: float | None = None, keep_space: bool = False):
     """The :class:`~femehl.accuracy.companions.Replayed` of ``stepper`` (a coarser
     discretization than ``run``'s) on ``run``'s time steps (``full``) and on steps twice as
-    long (``half``); ``stopped`` when one stops (a coarser mesh may not resolve the film),
-    ``half_stopped`` when only the one on steps twice as long does on adaptive steps (whose
-    controller has a time error of its own: a rough ball's doubled steps, 1.4 time units
-    after the run's own 0.8 had been cut, overshot the rough limit).  Nothing is logged
-    here (:func:`_report`).
+    long (``half``); ``stopped`` when one stops (a coarser mesh may not resolve the film).
+    With ``keep_space`` (a run whose step controller has a time error of its own), when
+    only the one on steps twice as long stops, ``full`` is kept and ``half_stopped`` says
+    why (a rough ball's doubled steps, 1.4 time units after the run's own 0.8 had been cut,
+    overshot the rough limit).  Nothing is logged here (:func:`_report`).
 
     Fixed steps ``dt``: ``dt`` and ``2 dt``.  Otherwise the run's own times ``run.t``
     (adaptive steps) replayed (:class:`femehl.solver.stepping.GivenSteps`), and every other
@@ -383,18 +383,18 @@ def replays(stepper, run, dt: float | None = None):
     else:
         halves = every_other_step(run.t, breakpoints_of(stepper.scene))
         plans = tuple({"steps": GivenSteps(ts, halvings=REPLAY_HALVINGS)} for ts in (run.t[1:], halves))
+    full = None
     try:
         full = run_loop(stepper, t_end, store_every=0, **plans[0])
-    except SolverError as exc:
-        return Replayed(stopped=(type(exc).__name__, str(exc)))
-    cut = getattr(plans[0].get("steps"), "cut", 0)
-    try:
         half = run_loop(stepper, t_end, store_every=0, **plans[1])
     except SolverError as exc:
-        if dt is not None:
-            return Replayed(stopped=(type(exc).__name__, str(exc)))
-        return Replayed(full, None, stepper.scheme.order, cut, half_stopped=(type(exc).__name__, str(exc)))
-    return Replayed(full, half, stepper.scheme.order, cut + getattr(plans[1].get("steps"), "cut", 0))
+        why = (type(exc).__name__, str(exc))
+        if full is None or not keep_space:
+            return Replayed(stopped=why)
+        cut = getattr(plans[0].get("steps"), "cut", 0)
+        return Replayed(full, None, stepper.scheme.order, cut, half_stopped=why)
+    cut = sum(getattr(plan.get("steps"), "cut", 0) for plan in plans)
+    return Replayed(full, half, stepper.scheme.order, cut)
 
 
 def _report(got, level_c: float, left: str = "") -> None:
@@ -461,10 +461,9 @@ def companion_run(scene, method, options, run: Result, dt, step_tol) -> tuple:
     if plan is None:
         return None, None, None, None
     coarse_options, ratio = plan
-    got = replays(make_stepper(scene, method, **coarse_options), run, dt if step_tol is None else None)
-    _report(
-        got, math.nan, "" if step_tol is None else "the estimate is the step controller's time error alone"
-    )
+    adaptive = step_tol is not None
+    got = replays(make_stepper(scene, method, **coarse_options), run, None if adaptive else dt, adaptive)
+    _report(got, math.nan, "the estimate is the step controller's time error alone" if adaptive else "")
     if got.stopped is not None:
         return None, None, None, None
     return got.full, got.half, ratio, got.order
@@ -618,8 +617,6 @@ def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) ->
     if got is None:
         got = _replay_now(_companion_maker(scene, method, ladder, t_end, level_c, options), run)
     run.info["estimate_wall"] = time.perf_counter() - t0
-    if got.half_stopped is not None:  # the automatic mode's estimate needs both companions
-        got = dataclasses.replace(got, full=None, stopped=got.half_stopped, half_stopped=None)
     _report(got, level_c)
     if got.stopped is not None:
         return None

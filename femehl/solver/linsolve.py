@@ -987,9 +987,10 @@ class RecycledGCR:
                 res = float(np.linalg.norm(rt))
                 hist.append(res / bnorm)
                 self.history = hist
-                if np.isfinite(res) and res <= tol and self.film_atol is not None and its < max_its:
+                reached = np.isfinite(res) and res <= tol
+                if reached and self.film_atol is not None and its < max_its:
                     ahead = self._film_check(C, rt)
-                if np.isfinite(res) and res <= tol and ahead is None:
+                if reached and ahead is None:
                     self.residuals.append(res / bnorm)
                     return x, Cx, gen, its, [(Z[j].copy(), CZ[j].copy()) for j in range(k_rec, k)]
                 if its >= max_its or not np.isfinite(res):

@@ -50,3 +50,54 @@ def test_entry_points_and_generators_run_limited(monkeypatch):
         scene, t_end=0.02, dt=0.01, mesh="coarse", estimate=False, callback=lambda s: states.append(_blas())
     )
     assert res.nsteps == 2 and all(set(b.values()) == {1} for b in states)
+
+
+# ---- the dense operator's row loops: the cores of a lone process, one in a parallel set ----
+def test_row_loops_cover_every_row_once_and_match_one_thread(monkeypatch):
+    """:func:`in_rows` hands out every row once, in any number of blocks; the products and the
+    Boussinesq build split by rows are the one-thread ones to the bit (each row's sum is
+    made in the same order)."""
+    import numpy as np
+
+    from femehl.discretize.fe_disk import FEDisc
+    from femehl.elastic import dense
+
+    seen = np.zeros(1001, dtype=int)
+
+    def mark(i0, i1):
+        seen[i0:i1] += 1
+
+    runs = {}
+    for k in (1, 3):
+        monkeypatch.setattr(dense, "loop_threads", lambda k=k: k)
+        seen[:] = 0
+        dense.in_rows(mark, seen.size)
+        assert np.all(seen == 1)
+        C = dense.SingleCompliance(np.random.default_rng(1).standard_normal((1001, 700)))
+        x = np.random.default_rng(2).standard_normal(700)
+        disc = FEDisc(femehl.presets.paper_sphere(), mesh="coarse", operator="dense")
+        runs[k] = (C @ x, disc.boussinesq())
+    assert np.array_equal(runs[1][0], runs[3][0]) and np.array_equal(runs[1][1], runs[3][1])
+
+
+def test_row_loops_run_on_one_thread_in_a_fork_or_off_the_main_thread():
+    """A lone process spreads its row loops over its cores; a forked one (the automatic
+    mode's companions) and a thread other than the main one keep to one: the parallelism
+    there is the processes'."""
+    import os
+    import threading
+
+    from femehl.elastic.dense import loop_threads
+
+    assert loop_threads() == len(os.sched_getaffinity(0))
+    got = []
+    th = threading.Thread(target=lambda: got.append(loop_threads()))
+    th.start()
+    th.join()
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        os.write(w, bytes([loop_threads()]))
+        os._exit(0)
+    os.waitpid(pid, 0)
+    assert got == [1] and os.read(r, 1) == bytes([1])

@@ -11,17 +11,60 @@ below tol = 1e-3.  docs/design.md section 3.
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
 import numba
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["SINGLE_MIN_ENTRIES", "SingleCompliance", "is_dense", "stored"]
+__all__ = ["SINGLE_MIN_ENTRIES", "SingleCompliance", "in_rows", "is_dense", "loop_threads", "stored"]
 
 #: a dense compliance with at least this many entries is stored in single precision
 #: (below it the products are cheap and the tests' small meshes keep it in double)
 SINGLE_MIN_ENTRIES = 1 << 22
 #: the sums may be reordered (vectorized) and fused; NaN and inf still propagate
 _SUMS = {"reassoc", "contract"}
+
+
+_PID = os.getpid()  # the process that imported femehl: its forks are companions or workers
+_POOL: tuple | None = None  # (threads, executor) of the row loops, made at their first use
+
+
+def loop_threads() -> int:
+    """Threads for the compiled loops over a dense operator's rows (:func:`in_rows`: its
+    build, its products): the CPUs this process may use, but one in a sweep's worker (a
+    daemon process), a forked process (the automatic mode's companions) or off the main
+    thread, where the parallelism is the processes' (docs/design.md section 16)."""
+    if (
+        os.getpid() != _PID
+        or multiprocessing.current_process().daemon
+        or threading.current_thread() is not threading.main_thread()
+    ):
+        return 1
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # no affinity on this platform
+        return max(1, os.cpu_count() or 1)
+
+
+def in_rows(work, n: int) -> None:
+    """``work(i0, i1)`` over ``range(n)`` in :func:`loop_threads` contiguous blocks, one
+    per thread (``work`` releases the GIL and writes rows of its own)."""
+    k = min(loop_threads(), max(1, n // 64))
+    if k == 1:
+        work(0, n)
+        return
+    global _POOL
+    if _POOL is None or _POOL[0] != k:
+        _POOL = (k, ThreadPoolExecutor(k - 1, thread_name_prefix="femehl-rows"))
+    bounds = [n * j // k for j in range(k + 1)]
+    others = [_POOL[1].submit(work, a, b) for a, b in zip(bounds[1:-1], bounds[2:], strict=True)]
+    work(0, bounds[1])  # the first block in this thread
+    for f in others:
+        f.result()
 
 
 def is_dense(C) -> bool:
@@ -57,7 +100,9 @@ class SingleCompliance:
         if x.ndim == 1:
             if x.shape[0] != self.shape[1]:
                 raise ValueError(f"C @ x: x has {x.shape[0]} entries for {self.shape[1]} columns")
-            return _matvec(self.a, x, np.empty(self.shape[0]))
+            y = np.empty(self.shape[0])
+            in_rows(lambda i0, i1: _matvec(self.a, x, y, i0, i1), self.shape[0])
+            return y
         return np.column_stack([self @ x[:, j] for j in range(x.shape[1])])
 
     def __rmatmul__(self, w):
@@ -77,12 +122,13 @@ class SingleCompliance:
         _csr_rmatmul(w.indptr, w.indices, w.data, self.a, out)
 
 
-@numba.njit(cache=True, fastmath=_SUMS, boundscheck=False)
-def _matvec(A, x, y):  # pragma: no cover - compiled
-    """``y = A x``, A float32, sums in float64; four rows at a time share the loads of x."""
-    m, n = A.shape
-    i = 0
-    while i + 4 <= m:
+@numba.njit(cache=True, nogil=True, fastmath=_SUMS, boundscheck=False)
+def _matvec(A, x, y, i0, i1):  # pragma: no cover - compiled
+    """Rows ``i0:i1`` of ``y = A x``, A float32, sums in float64; four rows at a time share
+    the loads of x (no GIL held: rows split among threads)."""
+    n = A.shape[1]
+    i = i0
+    while i + 4 <= i1:
         s0 = 0.0
         s1 = 0.0
         s2 = 0.0
@@ -95,7 +141,7 @@ def _matvec(A, x, y):  # pragma: no cover - compiled
             s3 += A[i + 3, j] * xj
         y[i], y[i + 1], y[i + 2], y[i + 3] = s0, s1, s2, s3
         i += 4
-    while i < m:
+    while i < i1:
         s = 0.0
         for j in range(n):
             s += A[i, j] * x[j]

@@ -16,6 +16,8 @@ import math
 import numba
 import numpy as np
 
+from femehl.elastic.dense import in_rows
+
 __all__ = [
     "triangle_influence",
     "influence_matrix",
@@ -233,9 +235,10 @@ def edge_products(points, nodes, edges, SP, mirror=False):
         raise ValueError(f"SP has {SP.shape[0]} rows for {B.shape[0]} edges")
     SP.sort_indices()
     out = np.empty((pts.shape[0], SP.shape[1]))
-    return _edge_products(
-        pts, nodes, B, C, bool(mirror), SP.indptr.astype(np.int64), SP.indices.astype(np.int64), SP.data, out
-    )
+    indptr, indices = SP.indptr.astype(np.int64), SP.indices.astype(np.int64)
+    args = (pts, nodes, B, C, bool(mirror), indptr, indices, SP.data, out)
+    in_rows(lambda i0, i1: _edge_products(*args, i0, i1), pts.shape[0])
+    return out
 
 
 def _edge_arrays(points, nodes, edges):
@@ -306,12 +309,13 @@ def _edge_rows(pts, nodes, B, C, mirror, out):  # pragma: no cover - compiled
     return out
 
 
-@numba.njit(cache=True, boundscheck=False)
-def _edge_products(pts, nodes, B, C, mirror, indptr, indices, data, out):  # pragma: no cover - compiled
+@numba.njit(cache=True, nogil=True, boundscheck=False)
+def _edge_products(pts, nodes, B, C, mirror, indptr, indices, data, out, i0, i1):  # pragma: no cover
+    """Rows ``i0:i1`` of :func:`edge_products` (no GIL held: rows split among threads)."""
     frame = _edge_frames(nodes, B, C)
     rho = np.empty((2, nodes.shape[0]))
     row = np.empty(B.shape[0])
-    for i in range(pts.shape[0]):
+    for i in range(i0, i1):
         _edge_row(pts[i, 0], pts[i, 1], nodes, B, C, frame, mirror, rho, row)
         for j in range(out.shape[1]):
             acc = 0.0

@@ -62,6 +62,8 @@ FITTED = "fitted"
 #: feabb35) and the former set-up: 1.44 at 7,998, 1.12 at 11,450, 0.90 at 14,112 (ratio 1
 #: near 12,700, the crossover 12,000).  Before it (6a7a811, double precision): 1.15 at
 #: 5,766, 0.90 at 7,998, 0.67 at 11,450, and the crossover was 8,000.
+#: Re-measured with the dense build and products on both cores (ca3d6df): 1.11 at 7,998,
+#: 0.83 at 11,450, 0.55 at 16,116 (ratio 1 near 9,100): the crossover stays.
 FAST_CROSSOVER = 9_500
 
 

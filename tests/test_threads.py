@@ -86,6 +86,7 @@ def test_row_loops_run_on_one_thread_in_a_fork_or_off_the_main_thread():
     there is the processes'."""
     import os
     import threading
+    import warnings
 
     from femehl.elastic.dense import loop_threads
 
@@ -95,7 +96,9 @@ def test_row_loops_run_on_one_thread_in_a_fork_or_off_the_main_thread():
     th.start()
     th.join()
     r, w = os.pipe()
-    pid = os.fork()
+    with warnings.catch_warnings():  # Python >= 3.12 warns of a fork beside threads
+        warnings.simplefilter("ignore", DeprecationWarning)
+        pid = os.fork()
     if pid == 0:  # pragma: no cover - the child
         os.write(w, bytes([loop_threads()]))
         os._exit(0)

@@ -59,6 +59,8 @@ def in_rows(work, n: int) -> None:
         return
     global _POOL
     if _POOL is None or _POOL[0] != k:
+        if _POOL is not None:
+            _POOL[1].shutdown(wait=False)
         _POOL = (k, ThreadPoolExecutor(k - 1, thread_name_prefix="femehl-rows"))
     bounds = [n * j // k for j in range(k + 1)]
     others = [_POOL[1].submit(work, a, b) for a, b in zip(bounds[1:-1], bounds[2:], strict=True)]

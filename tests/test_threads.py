@@ -57,27 +57,36 @@ def test_row_loops_cover_every_row_once_and_match_one_thread(monkeypatch):
     """:func:`in_rows` hands out every row once, in any number of blocks; the products and the
     Boussinesq build split by rows are the one-thread ones to the bit (each row's sum is
     made in the same order)."""
+    import functools
+
     import numpy as np
 
     from femehl.discretize.fe_disk import FEDisc
     from femehl.elastic import dense
 
     seen = np.zeros(1001, dtype=int)
+    blocks = []
 
     def mark(i0, i1):
         seen[i0:i1] += 1
+        blocks.append((i0, i1))
 
     runs = {}
     for k in (1, 3):
         monkeypatch.setattr(dense, "loop_threads", lambda k=k: k)
-        seen[:] = 0
+        seen[:], blocks[:] = 0, []
         dense.in_rows(mark, seen.size)
-        assert np.all(seen == 1)
+        assert np.all(seen == 1) and len(blocks) == k
         C = dense.SingleCompliance(np.random.default_rng(1).standard_normal((1001, 700)))
         x = np.random.default_rng(2).standard_normal(700)
         disc = FEDisc(femehl.presets.paper_sphere(), mesh="coarse", operator="dense")
-        runs[k] = (C @ x, disc.boussinesq())
-    assert np.array_equal(runs[1][0], runs[3][0]) and np.array_equal(runs[1][1], runs[3][1])
+        pools = []
+        for make in (functools.partial(C.__matmul__, x), disc.boussinesq):  # each in a pool of k
+            monkeypatch.setattr(dense, "_POOL", None)
+            runs.setdefault(k, []).append(make())
+            pools.append(None if dense._POOL is None else dense._POOL[0])
+        assert pools == ([None, None] if k == 1 else [k, k])
+    assert all(np.array_equal(a, b) for a, b in zip(runs[1], runs[3], strict=True))
 
 
 def test_row_loops_run_on_one_thread_in_a_fork_or_off_the_main_thread():

@@ -432,18 +432,18 @@ def one_run_estimate(run, full: Result, half: Result, ratio: float, order: int =
     (:func:`time_error`).  ``total = space + time``; ``levels``: (run's, companions') when known.
     """
     errors = {}
+    controller = time_error(run) if half is None else None
     for name in QUANTITIES:
         space = np.maximum.accumulate(pair_error(run, full, name, ratio))
         if half is None:
-            tpart = time_error(run)
-            errors[name] = {"total": space + tpart, "space": space, "time": tpart}
-            continue
-        th = np.asarray(half.t, dtype=float)
-        qh = getattr(half, name)
-        qf = np.array([full.value_at(name, t) for t in th])
-        qr = np.interp(th, run.t, getattr(run, name))
-        e = np.abs(qf - qh) / (2.0**order - 1.0) / _scale(name, qr, getattr(run, "scene", None))
-        tpart = np.maximum.accumulate(np.interp(run.t, th, e))
+            tpart = controller.copy()
+        else:
+            th = np.asarray(half.t, dtype=float)
+            qh = getattr(half, name)
+            qf = np.array([full.value_at(name, t) for t in th])
+            qr = np.interp(th, run.t, getattr(run, name))
+            e = np.abs(qf - qh) / (2.0**order - 1.0) / _scale(name, qr, getattr(run, "scene", None))
+            tpart = np.maximum.accumulate(np.interp(run.t, th, e))
         errors[name] = {"total": space + tpart, "space": space, "time": tpart}
     how = "companion" if half is not None else "companion+controller"
     return Estimate(np.asarray(run.t, dtype=float), errors, how, ratio, tuple(levels))

@@ -169,3 +169,23 @@ def test_a_step_product_adds_what_the_whole_product_would(single):
             np.testing.assert_allclose(b.matrix(dtype=dtype), a.matrix(dtype=dtype), rtol=0, atol=atol)
         idx = np.array([3, 50, 119])
         np.testing.assert_allclose(b.columns(idx), a.columns(idx), rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("q, lus", [(4.0, 0), (5.0, 1)])
+def test_a_step_four_times_longer_keeps_the_preconditioner(q, lus):
+    """``dt`` grown by up to 4 (``c_0 = a0/dt`` fallen to a quarter, ``KEY_CHANGE`` = 3)
+    keeps the LU: its preconditioned matrix ``I/q + (1 - 1/q) P^-1 D`` has a condition
+    number of at most q, a few iterations against ``factor_cost`` (40 here); more
+    refreshes it before the solve.  Both answers solve the system they were given."""
+    base, rng = _operator(seed=3)
+    c = 100.0  # the squeeze term dominates, as at the small steps after a breakpoint
+    at = lambda c: dataclasses.replace(base, films=[(c, *base.films[0][1:])], key=c)  # noqa: E731
+    solver = RecycledGCR(recycle=0)
+    _solve(solver, at(c), rng.random(200))
+    op = at(c / q)
+    b = rng.random(200)
+    x, its, got = _solve(solver, op, b)
+    np.testing.assert_allclose(op.matrix() @ x, b, rtol=0, atol=1e-7 * np.linalg.norm(b))
+    assert got == lus
+    if not lus:
+        assert its <= 8 < factor_cost(op), its

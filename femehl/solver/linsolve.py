@@ -606,17 +606,24 @@ class DirectSolver:
 
 
 #: refresh the preconditioner when ``c_0 = a0/dt`` fell by more than this fraction of the
-#: new ``c_0`` (1: to below half the factorized one, ``dt`` more than doubled).  Smaller
-#: changes, and any rise of ``c_0`` (a smaller ``dt``: a rejected trial, the restart at a
-#: breakpoint; the squeeze term ``c_0 F C`` the LU holds then dominates more), are left to
-#: the cost balancing.  An adaptive run's ``dt`` drifts by a few % a step: at 0.1 the
-#: paper case (fitted level 0.5, 11,472 elements, adaptive BDF2 at tol 3.1e-4) refreshed
-#: 74 times in 753 steps, 93 s of its 164 s; at 1, 25 times (35 s of 115 s) for 865
-#: preconditioned iterations instead of 690; with no such rule 20 times, but 940
-#: iterations and 121 s.  A rule both ways refreshed 33 times on fitted level 1, against
-#: 25 and 32 in two runs of this one (the cost balancing is timed by the wall clock).  A
-#: fixed-dt run changes ``c_0`` only at its first BDF2 step (``a0`` from 1 to 3/2).
-KEY_CHANGE = 1.0
+#: new ``c_0`` (3: to below a quarter of the factorized one, ``dt`` more than quadrupled).
+#: Smaller changes, and any rise of ``c_0`` (a smaller ``dt``: a rejected trial, the restart
+#: at a breakpoint; the squeeze term ``c_0 F C`` the LU holds then dominates more), are left
+#: to the cost balancing.  Why a factor q of ``dt`` costs little: with the LU of
+#: ``D + c F C`` and the step's ``D + (c/q) F C``, the preconditioned matrix is
+#: ``I/q + (1 - 1/q) P^-1 D``, whose spectrum lies between 1/q and 1 where ``P^-1 D``'s lies
+#: in [0, 1]: a condition number of at most q, a few iterations against the refresh's 40-110
+#: (:func:`factor_cost`).  An adaptive run's ``dt`` drifts by a few % a step but grows by
+#: 2-4 a step after t = 0 and after a breakpoint: at 0.1 the paper case (fitted level 0.5,
+#: 11,472 elements, adaptive BDF2 at tol 3.1e-4) refreshed 74 times in 753 steps, 93 s of
+#: its 164 s.  The paper case's automatic answer (5,992 cells, 2026-12-07, one BLAS thread,
+#: its run alone, two rounds each): at 1, 22 refreshes, 825 iterations, 12.7 s; at 2, 3, 5,
+#: 7 and none, 12 / 14 / 12 / 14 / 11 refreshes, 884 / 839 / 911 / 956 / 1,011 iterations,
+#: 10.8 / 10.7-11.0 / 11.0 / 12.0 / 11.0-11.2 s.  The layer's (14,030 cells, LU 2.4 s):
+#: 17 refreshes and 92.4 s at 1, 12 and 81.5 s at 3.  The load-controlled sphere and an
+#: ellipsoid on the fast operator: within 1 % either way.  A fixed-dt run changes ``c_0``
+#: only at its first BDF2 step (``a0`` from 1 to 3/2)
+KEY_CHANGE = 3.0
 
 #: the preconditioner's refresh balances its cost against the iterations it saves, both
 #: counted in preconditioned iterations (a model, not the clock: with measured times two

@@ -30,6 +30,7 @@ from femehl.validation import check_in_range
 __all__ = [
     "StepOperator",
     "SwitchedOperator",
+    "BorderedOperator",
     "LINEAR_SOLVERS",
     "register_linear_solver",
     "DirectSolver",
@@ -415,6 +416,110 @@ class SwitchedLU:
         return x
 
 
+class _BorderC:
+    """``C`` of a :class:`BorderedOperator` on ``[p; eta]``: ``C p + eta``, the film's change
+    (eta moves the whole film, in ``C``'s units), so ``G (C z)`` carries the column ``G 1``
+    and the film check sees hc as well as p."""
+
+    def __init__(self, C, n):
+        self.C, self.n = C, n
+        self.shape = (C.shape[0], n + 1)
+
+    def __matmul__(self, z):
+        return self.C @ z[: self.n] + z[self.n]
+
+    @staticmethod
+    def tail(w):
+        """The column of ``w^T C`` for eta (:meth:`RecycledGCR._tracked_ok`'s probes)."""
+        return w.sum(axis=1)
+
+
+class BorderedOperator:
+    """A step whose ``hc`` is one more unknown (an imposed load, a free indenter), bordered::
+
+        [ A       G 1 ] [ p   ]   [ b ]
+        [ -l^T    c   ] [ eta ] = [ f ]
+
+    ``A`` the :class:`StepOperator` ``inner`` (its held rows included), ``hc = scale eta``
+    (the film's scale: ``A p + hc G 1 / scale`` is the step's gap term), ``-l . p + c eta =
+    f`` the control's row (:meth:`femehl.solver.parts.ImposedLoad.border`).  ``C`` is
+    :class:`_BorderC`, so the Krylov solver needs nothing of its own for it; the
+    preconditioner is ``inner``'s with the border's Schur complement (:class:`BorderedLU`).
+    One solve a step instead of two (``A x1 = b``, ``A x2 = G 1``)."""
+
+    def __init__(self, inner: StepOperator, row, corner: float):
+        self.inner = inner
+        self.n = n = inner.D.shape[0]
+        self.row = np.asarray(row, dtype=float)
+        self.corner = float(corner)
+        self.key, self.held = inner.key, inner.held
+        self.C = _BorderC(inner.C, n)
+
+    @property
+    def dense(self) -> bool:
+        return self.inner.dense
+
+    @property
+    def fast(self) -> bool:
+        return self.inner.fast
+
+    @cached_property
+    def D(self):
+        last = sp.csr_matrix(np.append(-self.row, self.corner)[None, :])
+        return sp.vstack([sp.hstack([self.inner.D, sp.csr_matrix((self.n, 1))]), last], format="csr")
+
+    @cached_property
+    def G(self):
+        G = self.inner.G
+        return sp.vstack([G, sp.csr_matrix((1, G.shape[1]))], format="csr")
+
+    @cached_property
+    def column(self) -> np.ndarray:
+        """``G 1``: the rows of ``A`` for eta."""
+        return np.asarray(self.inner.G @ np.ones(self.inner.G.shape[1])).ravel()
+
+    apply = StepOperator.apply  # D Z + G C Z, with this operator's D, G and C
+
+    def factorize(self, dtype, t):
+        return BorderedLU(self.inner.factorize(dtype, t), self, t)
+
+    def matrix(self, dtype=np.float64):
+        """A sparse ``C``'s (Winkler, rigid) bordered sparse matrix; a dense one is solved
+        through :meth:`factorize`."""
+        if self.dense or self.fast:
+            raise SceneError("a bordered dense step is solved through factorize(), not matrix().")
+        last = sp.csr_matrix(np.append(-self.row, self.corner)[None, :])
+        top = sp.hstack([self.inner.matrix(), sp.csr_matrix(self.column[:, None])])
+        return sp.csc_matrix(sp.vstack([top, last]))
+
+
+class BorderedLU:
+    """The preconditioner (or the direct solve) of a :class:`BorderedOperator` from the LU
+    ``lu`` of its inner operator: ``w = M^-1 G 1`` and the Schur complement ``s = c + l . w``
+    of the step it follows (:meth:`follow`: one more solve with ``M`` a step), then
+    ``y = M^-1 r``, ``eta = (r_eta + l . y) / s``, ``z = y - eta w``."""
+
+    def __init__(self, lu, op: BorderedOperator, t: float):
+        self.lu = lu
+        self.follow(op, t)
+
+    def follow(self, op: BorderedOperator, t: float) -> None:
+        """Take the border of ``op`` (the step's column, row and corner)."""
+        self.row, self.n = op.row, op.n
+        self.w = self.lu.solve(op.column)
+        self.s = op.corner + float(self.row @ self.w)
+        if not np.isfinite(self.s) or self.s == 0.0:
+            raise SingularSystemError(
+                f"step at t = {t:.6g}: the load row is singular (the film does not respond to hc).", t=t
+            )
+
+    def solve(self, r):
+        n = self.n
+        y = self.lu.solve(r[:n])
+        eta = (r[n] + float(self.row @ y)) / self.s
+        return np.append(y - eta * self.w, eta)
+
+
 #: a tracked C x whose error exceeds this (relative, by the random probes) is formed instead:
 #: above the rounding of a combination of nearly collinear recycled solutions at small dt
 #: (1e-9 to 5e-9 measured on the paper case at dt = 0.0025, where the old solver accepted its
@@ -772,6 +877,9 @@ class RecycledGCR:
         no direct solve to fall back to).
     """
 
+    #: it solves a :class:`BorderedOperator` (an imposed load's step) in one Krylov solve
+    borders = True
+
     def __init__(
         self,
         rtol: float | None = None,
@@ -832,6 +940,9 @@ class RecycledGCR:
             return np.zeros_like(b), None
         f = self.factor
         fresh = f is None or f.stale or _key_moved(f.key, op.key)
+        fresh = fresh or isinstance(f.lu, BorderedLU) != isinstance(op, BorderedOperator)
+        if not fresh and isinstance(f.lu, BorderedLU):  # a bordered step: its own border
+            f.lu.follow(op, t)
         if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
             fresh = not f.lu.adapt(op)
         elif not fresh:
@@ -907,6 +1018,7 @@ class RecycledGCR:
         operator the sparse LU of its near-field part."""
         self.factor = None  # free the old factor before forming the new A
         t0 = time.perf_counter()
+        outer, op = op, getattr(op, "inner", op)  # a bordered step: its inner operator's LU
         if op.fast:
             A = op.near_matrix()
             if self._order is None or self._order.shape != A.shape or self._order.grown:
@@ -918,6 +1030,8 @@ class RecycledGCR:
                 lu = TwoLevel(lu, *coarse, t)
         else:
             lu = op.factorize(self.precond_dtype, t)
+        if outer is not op:
+            lu, op = BorderedLU(lu, outer, t), outer
         self._own_factorizations += 1
         self._own_factor_s += time.perf_counter() - t0
         self._sync()
@@ -940,6 +1054,9 @@ class RecycledGCR:
         rec = self.solutions + self.directions
         # generations of tracking behind each recycled C z (a direction's was formed: 0)
         rec_age = self._solution_ages + [0] * len(self.directions)
+        if any(z.size != b.size for z, _ in rec):  # a bordered step after one that was not
+            rec_age = [a for (z, _), a in zip(rec, rec_age, strict=True) if z.size == b.size]
+            rec = [(z, cz) for z, cz in rec if z.size == b.size]
         max_its = self._max_its(op)
         m = len(rec) + max_its
         n, ne = b.size, C.shape[0]
@@ -1056,13 +1173,15 @@ class RecycledGCR:
         ``C`` has no transpose here: its ``C x`` is formed every ``_MAX_TRACKED``
         generations instead.
         """
-        dense = C.C if isinstance(C, _Leading) else C
+        dense = C.C if isinstance(C, _Leading | _BorderC) else C
         if not is_dense(dense):
             return ages.size == 0 or int(ages.max()) < _MAX_TRACKED
         n = x.size
         if self._probe is None or self._probe[1].shape[1] != n:
             w = np.random.default_rng(20221).standard_normal((_PROBES, dense.shape[0]))
             u = w @ dense
+            if isinstance(C, _BorderC):  # a bordered step: eta moves the whole film
+                u = np.hstack([u, C.tail(w)[:, None]])
             if u.shape[1] != n:  # a switched step: C reads the pressure block only
                 u = np.hstack([u, np.zeros((_PROBES, n - u.shape[1]))])
             self._probe = (w, u, np.linalg.norm(w, axis=1))

@@ -106,12 +106,22 @@ class ImposedGap(GapControl):
 
 class ImposedLoad(GapControl):
     """``F(t)`` given, ``hc`` one more unknown.  The right-hand side is affine in hc
-    (``h = hc + s``), so with ``A x1 = b(h = s)`` and ``A x2 = G 1`` the bordered system
-    ``A p + hc G 1 = b(s)``, ``g . p = F`` gives ``hc = (g . x1 - F) / (g . x2)`` and
-    ``p = x1 - hc x2``: one operator, two right-hand sides, one linear system."""
+    (``h = hc + s``): the step's system is ``A p + hc G 1 = b(s)`` with the load row
+    ``-g . p + c hc = f`` (:meth:`border`; here ``g . p = F``).  The linear solver takes it
+    bordered, one solve (:class:`~femehl.solver.linsolve.BorderedOperator`), where it can;
+    otherwise from ``A x1 = b(s)`` and ``A x2 = G 1``: ``p = x1 - hc x2`` and
+    ``hc = (f + g . x1) / (c + g . x2)`` (:meth:`hc`)."""
 
     def rhs(self, stepper, rhs, G, shape, t_new):
         return [rhs - G @ shape, G @ np.ones(shape.size)]
+
+    def border(self, stepper, state, t_new, dt, ctx) -> tuple:
+        """``(c, f)`` of the step's load row ``-g . p + c hc = f``."""
+        return 0.0, -float(stepper.scene.motion.F(t_new))
+
+    def after(self, stepper, state, hc, t_new, dt, ctx) -> dict:
+        """The control's own variables after a step to ``hc``."""
+        return {}
 
     def close(self, stepper, solutions, state, t_new, dt, ctx):
         hc, own = self.hc(stepper, state, t_new, dt, ctx, *self._loads(stepper, solutions))
@@ -142,13 +152,17 @@ class ImposedLoad(GapControl):
         return x1 - hc * x2, (None if cx1 is None or cx2 is None else cx1 - hc * cx2)
 
     def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
-        """``(hc, own)``: the load row ``g . p = F``."""
-        if not np.isfinite(g2) or g2 == 0.0:
+        """``(hc, own)`` from the loads ``g . x1``, ``g . x2`` of the two solutions: the load
+        row ``-(g1 - hc g2) + c hc = f``."""
+        c, f = self.border(stepper, state, t_new, dt, ctx)
+        den = c + g2
+        if not np.isfinite(den) or den == 0.0:
             raise SingularSystemError(
                 f"step at t = {t_new:.6g}: the load row is singular (the film does not respond to hc).",
                 t=t_new,
             )
-        return (g1 - stepper.scene.motion.F(t_new)) / g2, {}
+        hc = (f + g1) / den
+        return hc, self.after(stepper, state, hc, t_new, dt, ctx)
 
 
 class FreeIndenter(ImposedLoad):
@@ -161,31 +175,36 @@ class FreeIndenter(ImposedLoad):
     def rest_load(self, stepper, t):
         return None  # its position hc(0) is an initial condition: it starts where it is
 
-    def hc(self, stepper, state, t_new, dt, ctx, g1, g2) -> tuple:
-        """``(hc, own)`` by the step's own scheme (BDF2 with its variable-step coefficients, or Euler) on hc
-        and v = hc'::
-
-            a0 hc' - (a1 hc - a2 hc_prev) = dt v',   m (a0 v' - (a1 v - a2 v_prev)) = dt f',
-
-        ``f' = g . p' - force(t')`` with ``g . p' = g1 - hc' g2`` linear in hc': one more
-        row, solved in closed form.  L-stable: a small mass tends to the imposed-load step
-        (``hc' = (g1 - force)/g2`` at m = 0)."""
+    @staticmethod
+    def _history(stepper, state, ctx) -> tuple:
+        """``(a0, a1 hc - a2 hc_prev, a1 v - a2 v_prev, v)`` of the step's scheme (the
+        one-step scheme at the first step, or after a restart without history)."""
         mo = stepper.scene.motion
-        m, a0, a1, a2 = mo.mass, ctx.a0, ctx.a1, ctx.a2
+        a0, a1, a2 = ctx.a0, ctx.a1, ctx.a2
         own = state.own
         v = own.get("hc_dot", mo.hc_dot0)
         if a2 != 0.0 and "hc_prev" in own and "hc_dot_prev" in own:
-            h_hist, v_hist = a1 * state.hc - a2 * own["hc_prev"], a1 * v - a2 * own["hc_dot_prev"]
-        else:  # the first step (or after a restart without history): the one-step scheme
-            a0, h_hist, v_hist = 1.0, state.hc, v
-        den = m * a0 * a0 / dt + dt * g2
-        if not np.isfinite(den) or den == 0.0:
-            raise SingularSystemError(
-                f"step at t = {t_new:.6g}: the free indenter's row is singular (m a0^2/dt + dt g.x2 = 0).",
-                t=t_new,
-            )
-        hc = (dt * (g1 - mo.applied_force(t_new)) + (m / dt) * (a0 * h_hist + dt * v_hist)) / den
-        return hc, {"hc_dot": (a0 * hc - h_hist) / dt, "hc_prev": state.hc, "hc_dot_prev": v}
+            return a0, a1 * state.hc - a2 * own["hc_prev"], a1 * v - a2 * own["hc_dot_prev"], v
+        return 1.0, state.hc, v, v
+
+    def border(self, stepper, state, t_new, dt, ctx) -> tuple:
+        """Newton's row by the step's own scheme (BDF2 with its variable-step coefficients,
+        or Euler) on hc and v = hc'::
+
+            a0 hc' - (a1 hc - a2 hc_prev) = dt v',   m (a0 v' - (a1 v - a2 v_prev)) = dt f',
+
+        ``f' = g . p' - force(t')``: eliminating v', ``-g . p' + (m a0^2 / dt^2) hc' =
+        (m / dt^2) (a0 h_hist + dt v_hist) - force(t')``.  L-stable: a small mass tends to
+        the imposed-load step (``g . p' = force`` at m = 0)."""
+        mo = stepper.scene.motion
+        a0, h_hist, v_hist, _ = self._history(stepper, state, ctx)
+        m = mo.mass
+        c = m * a0 * a0 / (dt * dt)
+        return c, (m / (dt * dt)) * (a0 * h_hist + dt * v_hist) - float(mo.applied_force(t_new))
+
+    def after(self, stepper, state, hc, t_new, dt, ctx) -> dict:
+        a0, h_hist, _, v = self._history(stepper, state, ctx)
+        return {"hc_dot": (a0 * hc - h_hist) / dt, "hc_prev": state.hc, "hc_dot_prev": v}
 
 
 def gap_control(motion) -> GapControl:

@@ -42,7 +42,8 @@ Scenes and why
     The paper sphere under an imposed load ``Motion(gap=0.1, load=F(t))``: F ramps from 0
     to the Hertz load 4/(3 pi) of hc = -1 over t in [0, 1] (``RampHold(0, 4/(3 pi), 1)``:
     a load history like the paper's gap ramp), then the paper's sliding.  hc(t) is an
-    unknown (one extra row per step); the load is then exact and the films carry the error.
+    unknown (one extra row per step); the load then holds to the solve's tolerance (1e-8) and the
+    films carry the error.
 ``winkler``, t_end 2
     The sphere on a Winkler foundation k = 0.25 (w = -p/k), pressed to hc = -0.5 (contact
     radius sqrt(2 * 0.5) = 1; dry peak pressure k * 0.5 = 0.125 and load

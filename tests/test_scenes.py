@@ -394,7 +394,10 @@ def test_elastic_sphere_approaches_hertz(scale):
     hc_H = -(scale ** (2.0 / 3.0))
     r = hertz_run(F)
     hold = r.t >= 0.5
-    assert np.max(np.abs(r.load[hold] - F)) <= 1e-9 * F
+    # the load row is a row of the step's one (bordered) solve, held to its relative residual:
+    # rtol 1e-8, the row scaled to the right-hand side's size, so at most sqrt(2) rtol of F
+    # (measured 1.5e-9; 1e-15 when hc came from two solves in closed form)
+    assert np.max(np.abs(r.load[hold] - F)) <= 2e-8 * F
     hc = r.hc[hold]
     assert np.all(np.diff(hc) < 0.0)  # keeps sinking
     assert np.all(hc > hc_H)  # from above

@@ -440,12 +440,15 @@ class BorderedOperator:
         [ A       G 1 ] [ p   ]   [ b ]
         [ -l^T    c   ] [ eta ] = [ f ]
 
-    ``A`` the :class:`StepOperator` ``inner`` (its held rows included), ``hc = scale eta``
-    (the film's scale: ``A p + hc G 1 / scale`` is the step's gap term), ``-l . p + c eta =
-    f`` the control's row (:meth:`femehl.solver.parts.ImposedLoad.border`).  ``C`` is
+    ``A`` the dense or fast :class:`StepOperator` ``inner`` (its held rows included), eta
+    hc's change from the last step over the film's scale (``A p + hc G 1 / scale`` is the
+    step's gap term), ``-l . p + c eta = f`` the control's row
+    (:meth:`femehl.solver.parts.ImposedLoad.border`, scaled by the stepper to the
+    right-hand side's size).  ``C`` is
     :class:`_BorderC`, so the Krylov solver needs nothing of its own for it; the
-    preconditioner is ``inner``'s with the border's Schur complement (:class:`BorderedLU`).
-    One solve a step instead of two (``A x1 = b``, ``A x2 = G 1``)."""
+    preconditioner (and the direct solve) is ``inner``'s LU with the border's Schur
+    complement (:class:`BorderedLU`).  One solve a step instead of two (``A x1 = b``,
+    ``A x2 = G 1``)."""
 
     def __init__(self, inner: StepOperator, row, corner: float):
         self.inner = inner
@@ -482,15 +485,6 @@ class BorderedOperator:
 
     def factorize(self, dtype, t):
         return BorderedLU(self.inner.factorize(dtype, t), self, t)
-
-    def matrix(self, dtype=np.float64):
-        """A sparse ``C``'s (Winkler, rigid) bordered sparse matrix; a dense one is solved
-        through :meth:`factorize`."""
-        if self.dense or self.fast:
-            raise SceneError("a bordered dense step is solved through factorize(), not matrix().")
-        last = sp.csr_matrix(np.append(-self.row, self.corner)[None, :])
-        top = sp.hstack([self.inner.matrix(), sp.csr_matrix(self.column[:, None])])
-        return sp.csc_matrix(sp.vstack([top, last]))
 
 
 class BorderedLU:

@@ -440,7 +440,8 @@ class BorderedOperator:
         [ A       G 1 ] [ p   ]   [ b ]
         [ -l^T    c   ] [ eta ] = [ f ]
 
-    ``A`` the dense or fast :class:`StepOperator` ``inner`` (its held rows included), eta
+    ``A`` the dense or fast :class:`StepOperator` ``inner`` (its held rows included), or a
+    :class:`SwitchedOperator` (JFO's cavitated nodes, whose gas follows the pressure), eta
     hc's change from the last step over the film's scale (``A p + hc G 1 / scale`` is the
     step's gap term), ``-l . p + c eta = f`` the control's row
     (:meth:`femehl.solver.parts.ImposedLoad.border`, scaled by the stepper to the
@@ -455,7 +456,9 @@ class BorderedOperator:
         self.n = n = inner.D.shape[0]
         self.row = np.asarray(row, dtype=float)
         self.corner = float(corner)
-        self.key, self.held = inner.key, inner.held
+        self.key = inner.key
+        self.held = getattr(inner, "held", None)  # the rows a preconditioner refresh watches
+        self.switched = getattr(inner, "switched", None)
         self.C = _BorderC(inner.C, n)
 
     @property
@@ -935,12 +938,14 @@ class RecycledGCR:
         f = self.factor
         fresh = f is None or f.stale or _key_moved(f.key, op.key)
         fresh = fresh or isinstance(f.lu, BorderedLU) != isinstance(op, BorderedOperator)
-        if not fresh and isinstance(f.lu, BorderedLU):  # a bordered step: its own border
-            f.lu.follow(op, t)
-        if not fresh and hasattr(f.lu, "adapt"):  # a switched step: follow its set
-            fresh = not f.lu.adapt(op)
+        bordered = not fresh and isinstance(f.lu, BorderedLU)
+        lu, inner = (f.lu.lu, op.inner) if bordered else (None if fresh else f.lu, op)
+        if not fresh and hasattr(lu, "adapt"):  # a switched step: follow its set
+            fresh = not lu.adapt(inner)
         elif not fresh:
             fresh = _rows_moved(f.rows, _replaced_rows(op), self._row_budget(op))
+        if not fresh and bordered:  # a bordered step: its own border, on the LU as it is now
+            f.lu.follow(op, t)
         if fresh:
             # drop this frame's reference first: _refactor frees the old factor before it
             # forms the new matrix, which a live local would keep (one n x n array more at
@@ -1167,17 +1172,20 @@ class RecycledGCR:
         ``C`` has no transpose here: its ``C x`` is formed every ``_MAX_TRACKED``
         generations instead.
         """
-        dense = C.C if isinstance(C, _Leading | _BorderC) else C
+        bordered = isinstance(C, _BorderC)
+        dense = C.C if bordered else C
+        leading = dense.shape[1] if isinstance(dense, _Leading) else None
+        dense = dense.C if isinstance(dense, _Leading) else dense
         if not is_dense(dense):
             return ages.size == 0 or int(ages.max()) < _MAX_TRACKED
         n = x.size
         if self._probe is None or self._probe[1].shape[1] != n:
             w = np.random.default_rng(20221).standard_normal((_PROBES, dense.shape[0]))
             u = w @ dense
-            if isinstance(C, _BorderC):  # a bordered step: eta moves the whole film
+            if leading is not None:  # a switched step: C reads the pressure block only
+                u = np.hstack([u, np.zeros((_PROBES, leading - u.shape[1]))])
+            if bordered:  # a bordered step: eta moves the whole film
                 u = np.hstack([u, C.tail(w)[:, None]])
-            if u.shape[1] != n:  # a switched step: C reads the pressure block only
-                u = np.hstack([u, np.zeros((_PROBES, n - u.shape[1]))])
             self._probe = (w, u, np.linalg.norm(w, axis=1))
         # the probes are formed once: C is fixed for a solver's life (its recycled C z are too)
         w, u, wn = self._probe

@@ -34,6 +34,7 @@ from femehl.solver.linsolve import (
     BorderedOperator,
     StepOperator,
     StepProduct,
+    SwitchedOperator,
     film_tolerances,
     make_linear_solver,
 )
@@ -449,11 +450,14 @@ class LaggedStepper:
         """The load row ``l`` (the load weights on the pressure unknowns) when this step is
         solved bordered (:class:`~femehl.solver.linsolve.BorderedOperator`: the gap control
         has a row, the solver takes it, the system is a dense or fast
-        :class:`~femehl.solver.linsolve.StepOperator` and its second right-hand side is the
-        column ``G 1 / scale`` the border carries); None: two right-hand sides."""
+        :class:`~femehl.solver.linsolve.StepOperator` or JFO's switched one, and its second
+        right-hand side is the column ``G 1 / scale`` the border carries); None: two
+        right-hand sides."""
         if not (hasattr(self.gap, "border") and getattr(self.solver, "borders", False)):
             return None
-        if type(system) is not StepOperator or not (system.dense or system.fast) or len(rhs_list) != 2:
+        if type(system) not in (StepOperator, SwitchedOperator) or len(rhs_list) != 2:
+            return None
+        if not (system.dense or system.fast):
             return None
         col = np.asarray(system.G @ np.ones(system.G.shape[1])).ravel() / scale
         if not np.allclose(

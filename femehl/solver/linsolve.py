@@ -451,11 +451,14 @@ class BorderedOperator:
     complement (:class:`BorderedLU`).  One solve a step instead of two (``A x1 = b``,
     ``A x2 = G 1``)."""
 
-    def __init__(self, inner: StepOperator, row, corner: float):
+    def __init__(self, inner: StepOperator, row, corner: float, column=None):
         self.inner = inner
         self.n = n = inner.D.shape[0]
         self.row = np.asarray(row, dtype=float)
         self.corner = float(corner)
+        if column is None:  # G 1: the rows of A for eta (the stepper has it: its check's)
+            column = inner.G @ np.ones(inner.G.shape[1])
+        self.column = np.asarray(column, dtype=float).ravel()
         self.key = inner.key
         self.held = getattr(inner, "held", None)  # the rows a preconditioner refresh watches
         self.switched = getattr(inner, "switched", None)
@@ -478,11 +481,6 @@ class BorderedOperator:
     def G(self):
         G = self.inner.G
         return sp.vstack([G, sp.csr_matrix((1, G.shape[1]))], format="csr")
-
-    @cached_property
-    def column(self) -> np.ndarray:
-        """``G 1``: the rows of ``A`` for eta."""
-        return np.asarray(self.inner.G @ np.ones(self.inner.G.shape[1])).ravel()
 
     apply = StepOperator.apply  # D Z + G C Z, with this operator's D, G and C
 

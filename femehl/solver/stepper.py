@@ -128,6 +128,7 @@ class LaggedStepper:
         self.s0 = float(np.asarray(disc.gap(self.origin)).ravel()[0])
         self.shape = disc.shape
         self.g = disc.load_weights
+        self._load_row = None  # the load weights on a bordered system's unknowns (_border)
         from femehl.problem.cavitation import cavitation_model
 
         self.cavitation = cavitation_model(getattr(scene, "cavitation", None))
@@ -440,33 +441,37 @@ class LaggedStepper:
         size = max(abs(f), abs(float(state.load)))
         rho = float(np.linalg.norm(b)) / size if size > 0.0 else 1.0
         rho = rho if np.isfinite(rho) and rho > 0.0 else 1.0
-        bordered = BorderedOperator(system, rho * border, rho * c * scale)
+        row, column = border
+        bordered = BorderedOperator(system, rho * row, rho * c * scale, column)
         ((xe, cxe),) = self.solver.solve(bordered, [np.append(b, rho * f)], ctx.t_new)
         hc = hc0 + scale * float(xe[-1])
         Cp = None if cxe is None else cxe - xe[-1]  # C p: the film's change less eta's
         return xe[:-1], Cp, hc, self.gap.after(self, state, hc, ctx.t_new, ctx.dt, ctx)
 
     def _border(self, system, rhs_list, scale):
-        """The load row ``l`` (the load weights on the pressure unknowns) when this step is
-        solved bordered (:class:`~femehl.solver.linsolve.BorderedOperator`: the gap control
-        has a row, the solver takes it, the system is a dense or fast
+        """``(l, G 1)``: the load row (the load weights on the pressure unknowns) and the
+        column of the step's operator for hc, when this step is solved bordered
+        (:class:`~femehl.solver.linsolve.BorderedOperator`: the gap control has a row, the
+        solver takes it, the system is a dense or fast
         :class:`~femehl.solver.linsolve.StepOperator` or JFO's switched one, and its second
-        right-hand side is the column ``G 1 / scale`` the border carries); None: two
-        right-hand sides."""
+        right-hand side is that column over ``scale``); None: two right-hand sides."""
         if not (hasattr(self.gap, "border") and getattr(self.solver, "borders", False)):
             return None
         if type(system) not in (StepOperator, SwitchedOperator) or len(rhs_list) != 2:
             return None
         if not (system.dense or system.fast):
             return None
-        col = np.asarray(system.G @ np.ones(system.G.shape[1])).ravel() / scale
+        column = np.asarray(system.G @ np.ones(system.G.shape[1])).ravel()
+        given = scale * np.asarray(rhs_list[1])
         if not np.allclose(
-            col, rhs_list[1], rtol=1e-12, atol=1e-14 * float(np.max(np.abs(col), initial=0.0))
+            column, given, rtol=1e-12, atol=1e-14 * float(np.max(np.abs(column), initial=0.0))
         ):
             return None  # a part changed the second right-hand side: it is solved as given
-        row = np.zeros(system.D.shape[0])
-        row[: self.disc.n] = self.g
-        return row
+        size = system.D.shape[0]
+        if self._load_row is None or self._load_row.size != size:  # the mesh's: once per size
+            self._load_row = np.zeros(size)
+            self._load_row[: self.disc.n] = self.g
+        return self._load_row, column
 
     def _held(self, system, rhs_list, ctx, shape, scale):
         """A held row says ``p = 0`` of the film's pressure: the parts that carry a share of

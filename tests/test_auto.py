@@ -226,6 +226,37 @@ def test_meshes_are_adapted_to_the_first_run_only(monkeypatch):
     assert res.disc.dm.name.startswith("adapted")
 
 
+def test_the_first_runs_lost_estimate_is_no_warning(monkeypatch, caplog):
+    """The first run only aims the next: when its companions stop (the film closed on their
+    mesh of a few hundred cells, as on the layer and Winkler scenes of the benchmark), the
+    default path does not warn the user to try a smaller dt or a finer mesh; it says at
+    INFO what follows, a run RATIO_MAX finer with a time tolerance RATIO_MAX^2 smaller.
+    (An expert run's companions that stop still warn: the test of femehl.accuracy.companions.)"""
+    import femehl.accuracy.auto as auto
+    from femehl.accuracy import companions as comp
+
+    monkeypatch.setenv(comp.ENV, "serial")
+    real, calls = auto._replay_now, []
+
+    def replay_now(make, run):
+        calls.append(run.info["level"])
+        if len(calls) == 1:
+            return comp.Replayed(stopped=("FilmRuptureError", "film closed (test)"))
+        return real(make, run)
+
+    monkeypatch.setattr(auto, "_replay_now", replay_now)
+    with caplog.at_level(logging.INFO, logger="femehl"):
+        res = femehl.solve(femehl.presets.paper_sphere(), t_end=0.05, tol=3e-2, store_every=0)
+    a = res.info["auto"]
+    assert a["reached"] and len(calls) == 2
+    assert a["levels"][1] == pytest.approx(a["levels"][0] / auto.RATIO_MAX)
+    assert a["tol_t"][1] == pytest.approx(a["tol_t"][0] / auto.RATIO_MAX**2)
+    said = [r for r in caplog.records if "film closed (test)" in r.getMessage()]
+    assert [r.levelno for r in said] == [logging.INFO]
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+    assert any("without the first run's estimate" in r.getMessage() for r in caplog.records)
+
+
 def test_sphere_is_honest():
     """The paper sphere to t = 1.5 at tol = 3e-2: level 2 on fitted meshes (788 cells), then
     one run on meshes adapted to it, level 1.32 (1,757 cells, 82 steps), 6.5 s.  Measured

@@ -397,22 +397,25 @@ def replays(stepper, run, dt: float | None = None, keep_space: bool = False):
     return Replayed(full, half, stepper.scheme.order, cut)
 
 
-def _report(got, level_c: float, left: str = "") -> None:
+def _report(got, level_c: float, left: str = "", level: int = logging.WARNING) -> None:
     """Log what the companions (at ``level_c``) could not do: a mesh, a stop, steps cut;
-    ``left``: what estimate is left without them (none by default)."""
+    ``left``: what estimate is left without them (none by default); at ``level``
+    (INFO for an automatic sequence's first run, whose estimate only aims the next run)."""
     lost = "no error estimate" if not left else f"no space error estimate ({left})"
     if got.half_stopped is not None:
-        logger.warning(
+        logger.log(
+            level,
             "femehl: the time part of the error estimate is the step controller's: the coarser "
             "companion on steps twice as long stopped (%s)",
             got.half_stopped[1],
         )
     if got.stopped is not None and got.stopped[0] == "MeshError":
-        logger.warning("femehl: %s: the companions' mesh (level %.3g): %s", lost, level_c, got.stopped[1])
+        logger.log(level, "femehl: %s: the companions' mesh (level %.3g): %s", lost, level_c, got.stopped[1])
     elif got.stopped is not None:
-        logger.warning("femehl: %s: the coarser companion run stopped (%s)", lost, got.stopped[1])
+        logger.log(level, "femehl: %s: the coarser companion run stopped (%s)", lost, got.stopped[1])
     elif got.cut:
-        logger.warning(
+        logger.log(
+            level,
             "femehl: the companions cut %d of the run's steps in two (a step failed on their coarser "
             "mesh): their estimate there holds a time error too",
             got.cut,
@@ -597,12 +600,13 @@ def _replay_now(make, run):
     return replays(stepper, run)
 
 
-def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) -> Estimate | None:
+def _estimate(scene, method, ladder, t_end, level, options, run, beside=None, seeds=False) -> Estimate | None:
     """``run``'s estimate from its companions at :data:`COMPANION_RATIO` times its ``level``
     on ``ladder`` (None, logged, when they stop): from ``beside`` (a
     :class:`~femehl.accuracy.companions.Companions` that followed the run), or replayed now
     (:func:`replays`); the wall time this adds after the run in ``run.info["estimate_wall"]``.
-    ``run`` has ``t``, the :data:`QUANTITIES` and ``info``."""
+    ``run`` has ``t``, the :data:`QUANTITIES` and ``info``; ``seeds``: it is the first run of
+    a sequence, not the answer (what its companions could not do is logged at INFO)."""
     t0 = time.perf_counter()
     level_c = COMPANION_RATIO * level
     # a companion does less work than the run: one still busy long after it has hung
@@ -617,8 +621,15 @@ def _estimate(scene, method, ladder, t_end, level, options, run, beside=None) ->
     if got is None:
         got = _replay_now(_companion_maker(scene, method, ladder, t_end, level_c, options), run)
     run.info["estimate_wall"] = time.perf_counter() - t0
-    _report(got, level_c)
+    _report(got, level_c, level=logging.INFO if seeds else logging.WARNING)
     if got.stopped is not None:
+        if seeds:
+            logger.info(
+                "auto: without the first run's estimate the next run is %.3g times finer, its time "
+                "tolerance %.3g times smaller",
+                RATIO_MAX,
+                RATIO_MAX**2,
+            )
         return None
     full, half = got.full, got.half
     est = one_run_estimate(run, full, half, COMPANION_RATIO, got.order, (level, level_c))
@@ -948,7 +959,7 @@ def solve_to_tolerance(
                 level /= 2.0  # the film closed on this mesh: a finer one decides whether it really closes
                 tol_t = min(tol_t, time_tolerance(level))
                 continue
-            est = _estimate(scene, method, ladder, t_end, level, options, res, beside)
+            est = _estimate(scene, method, ladder, t_end, level, options, res, beside, seeds)
         err = math.nan if est is None else est.worst()
         if fine is not None:
             fine._stored.clear()  # superseded: its scalars stay, its fields go

@@ -44,12 +44,18 @@ HAND_LEVELS = (1.41, 1.0, 0.71)
 HAND_LEVELS_PAPER = (0.6, 0.55, 0.5)
 HAND_DT = (0.02, 0.01)
 #: finer levels for the scenes where no level of HAND_LEVELS is within tol = 1e-2 (the
-#: film_min's space error at level 0.71: viscoelastic 2.9-3.3 %, layer 1.4-3.3 %, free indenter 1.4 %)
+#: film_min's space error at level 0.71: viscoelastic 2.9-3.3 %, layer 1.4-3.3 %, free indenter
+#: 1.4 %), and for the plug-in scenes one level more, where the grid had no setting as accurate
+#: as the automatic answer (the issue's target for them is an expert run of the same accuracy:
+#: JFO's level 0.71 is 0.93 % off against the answer's 0.74 %, the viscoelastic level 0.35
+#: 0.92 % against 0.67 %; the layer's level 0.5 0.67 % against 0.52 %, and its level 0.42 no
+#: closer, 0.68 %: the layer's reference is uncertain by 0.70 % in the minimum film)
 HAND_LEVELS_MORE = {
     "paper": HAND_LEVELS_PAPER,
-    "viscoelastic": (0.5, 0.35),
-    "layer": (0.5,),
+    "viscoelastic": (0.5, 0.35, 0.25),
+    "layer": (0.5, 0.42),
     "free_indenter": (0.5,),  # level 0.71 is within tol at dt = 0.02 only (0.82 %; 1.41 % at 0.01)
+    "jfo": (0.5,),
 }
 #: the paper case also on the mesh ladder graded for it (the settings of `femehl bench accuracy`)
 HAND_LADDER = {"paper": ("coarse", "medium", "fine")}

@@ -1015,7 +1015,9 @@ class RecycledGCR:
         operator the sparse LU of its near-field part."""
         self.factor = None  # free the old factor before forming the new A
         t0 = time.perf_counter()
-        outer, op = op, getattr(op, "inner", op)  # a bordered step: its inner operator's LU
+        outer = op
+        if isinstance(op, BorderedOperator):  # a bordered step: its inner operator's LU
+            op = op.inner
         if op.fast:
             A = op.near_matrix()
             if self._order is None or self._order.shape != A.shape or self._order.grown:
